@@ -1,0 +1,172 @@
+//! The world box and what its border does to critters that reach it: bounce, wrap or clamp.
+
+use crate::vector::Vector;
+use serde::{Deserialize, Serialize};
+
+/// What happens at the edge of the world box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Border {
+    /// Reflect off the edge (with the critter's restitution).
+    #[default]
+    Bounce,
+    /// Periodic: leave on one side, come back on the other; distances use the nearest image.
+    Wrap,
+    /// Stop at the edge: position clamped, the outward part of the velocity removed.
+    Clamp,
+}
+
+impl std::str::FromStr for Border {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "bounce" => Ok(Border::Bounce),
+            "wrap" => Ok(Border::Wrap),
+            "clamp" => Ok(Border::Clamp),
+            other => Err(format!(
+                "unknown border '{other}': use bounce, wrap or clamp"
+            )),
+        }
+    }
+}
+
+/// The world box and its border rule: everything that decides distances and cell coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Topology<V: Vector> {
+    /// Lower corner.
+    pub min: V,
+    /// Upper corner.
+    pub max: V,
+    /// Border rule.
+    pub border: Border,
+}
+
+impl<V: Vector> Topology<V> {
+    /// Size of the box.
+    #[inline]
+    pub fn size(&self) -> V {
+        self.max - self.min
+    }
+
+    /// True when the border is periodic.
+    #[inline]
+    pub fn wraps(&self) -> bool {
+        self.border == Border::Wrap
+    }
+
+    /// `b - a`, reduced to the nearest periodic image when the border wraps.
+    #[inline]
+    pub fn delta(&self, a: V, b: V) -> V {
+        let mut d = b - a;
+        if self.wraps() {
+            let size = self.size();
+            for axis in 0..V::DIM {
+                let l = size.get(axis);
+                let x = d.get(axis);
+                if x.abs() > 0.5 * l {
+                    d.set(axis, x - l * (x / l).round());
+                }
+            }
+        }
+        d
+    }
+
+    /// Applies the border to a disk of radius `r`: returns the new position and velocity.
+    ///
+    /// Bounce mirrors the position about the edge (exact for straight-line motion) and reflects
+    /// the normal velocity with restitution `e` when it points outward. Wrap maps the centre back
+    /// into the box. Clamp stops the disk at the edge.
+    #[inline]
+    pub fn apply(&self, mut pos: V, mut vel: V, r: f64, e: f64) -> (V, V) {
+        for axis in 0..V::DIM {
+            let lo = self.min.get(axis);
+            let hi = self.max.get(axis);
+            let x = pos.get(axis);
+            match self.border {
+                Border::Wrap => {
+                    if x < lo || x >= hi {
+                        let l = hi - lo;
+                        let mut w = lo + (x - lo).rem_euclid(l);
+                        if w >= hi {
+                            w = lo; // rem_euclid can round up to l
+                        }
+                        pos.set(axis, w);
+                    }
+                }
+                Border::Bounce => {
+                    let (lo, hi) = (lo + r, hi - r);
+                    if lo > hi {
+                        pos.set(axis, 0.5 * (lo + hi));
+                        vel.set(axis, 0.0);
+                    } else if x < lo {
+                        pos.set(axis, (lo + (lo - x)).min(hi));
+                        let v = vel.get(axis);
+                        if v < 0.0 {
+                            vel.set(axis, -e * v);
+                        }
+                    } else if x > hi {
+                        pos.set(axis, (hi - (x - hi)).max(lo));
+                        let v = vel.get(axis);
+                        if v > 0.0 {
+                            vel.set(axis, -e * v);
+                        }
+                    }
+                }
+                Border::Clamp => {
+                    let (lo, hi) = (lo + r, hi - r);
+                    if lo > hi {
+                        pos.set(axis, 0.5 * (lo + hi));
+                        vel.set(axis, 0.0);
+                    } else if x < lo {
+                        pos.set(axis, lo);
+                        vel.set(axis, vel.get(axis).max(0.0));
+                    } else if x > hi {
+                        pos.set(axis, hi);
+                        vel.set(axis, vel.get(axis).min(0.0));
+                    }
+                }
+            }
+        }
+        (pos, vel)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    fn topo(border: Border) -> Topology<DVec2> {
+        Topology {
+            min: DVec2::ZERO,
+            max: DVec2::new(10.0, 5.0),
+            border,
+        }
+    }
+
+    #[test]
+    fn wrap_maps_back_into_the_box_and_uses_the_nearest_image() {
+        let t = topo(Border::Wrap);
+        let (p, v) = t.apply(DVec2::new(10.5, -0.25), DVec2::new(1.0, -1.0), 0.5, 1.0);
+        assert_eq!(p, DVec2::new(0.5, 4.75));
+        assert_eq!(v, DVec2::new(1.0, -1.0));
+        let d = t.delta(DVec2::new(0.2, 0.1), DVec2::new(9.9, 4.9));
+        assert!((d - DVec2::new(-0.3, -0.2)).length() < 1e-12);
+    }
+
+    #[test]
+    fn bounce_mirrors_position_and_reflects_outward_velocity() {
+        let t = topo(Border::Bounce);
+        let (p, v) = t.apply(DVec2::new(9.8, 2.0), DVec2::new(2.0, 1.0), 0.5, 1.0);
+        assert!((p.x - 9.2).abs() < 1e-12);
+        assert_eq!(v, DVec2::new(-2.0, 1.0));
+    }
+
+    #[test]
+    fn clamp_stops_at_the_edge() {
+        let t = topo(Border::Clamp);
+        let (p, v) = t.apply(DVec2::new(-1.0, 2.0), DVec2::new(-2.0, 1.0), 0.5, 1.0);
+        assert_eq!(p, DVec2::new(0.5, 2.0));
+        assert_eq!(v, DVec2::new(0.0, 1.0));
+    }
+}

@@ -1,0 +1,464 @@
+//! Broad phase: candidate pairs whose bounding boxes overlap, and nothing else.
+//!
+//! The structure is a hierarchical grid rebuilt every step. Each object goes to the finest level
+//! whose cell is at least as wide as the object (level L has cells of `s0 * 2^L`, `s0` the smallest
+//! object's width), so widely varying radii cost no more than uniform ones: an object meets the
+//! objects of its own level in its own and the neighbouring cells (a half stencil, so each pair is
+//! produced once), and those of every coarser level in the 3^D cells around its position there.
+//! Within a level the objects are counting-sorted by cell, which keeps memory access local. The
+//! output order depends only on the objects, never on a hash or a thread count.
+//!
+//! For small scenes a direct loop over all pairs is cheaper than building a grid; [`SMALL_N`] is
+//! where `benches/step.rs` measured the two to cross.
+//!
+//! Walls never pair with walls.
+
+use crate::border::Topology;
+use crate::vector::Vector;
+
+/// Below this many objects the direct all-pairs loop is used (see `docs/performance.md`).
+pub const SMALL_N: usize = 48;
+
+/// An object for the broad phase: a centre and per-axis half sizes of its bounding box.
+#[derive(Clone, Copy, Debug)]
+pub struct BroadObject<V> {
+    /// Centre of the bounding box.
+    pub center: V,
+    /// Half sizes of the bounding box, per world axis.
+    pub half: V,
+    /// The id to report in pairs (the critter's slot index).
+    pub slot: u32,
+    /// Walls never pair with walls.
+    pub is_wall: bool,
+}
+
+/// Which algorithm to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BroadPhaseMode {
+    /// Direct loop for small scenes, grid otherwise.
+    #[default]
+    Auto,
+    /// Always the grid.
+    Grid,
+    /// Always the direct all-pairs loop (the naive baseline).
+    AllPairs,
+}
+
+#[derive(Default)]
+struct Level {
+    inv_cell: [f64; 3],
+    dims: [usize; 3],
+    wrap: [bool; 3],
+    /// Object indices on this level.
+    members: Vec<u32>,
+    /// Cell key of each member (parallel to `members`, then to `sorted`).
+    keys: Vec<u32>,
+    /// `start[k]..start[k + 1]` indexes `sorted` for cell `k`.
+    start: Vec<u32>,
+    /// Members ordered by cell.
+    sorted: Vec<u32>,
+}
+
+impl Level {
+    #[inline]
+    fn coords<V: Vector>(&self, topo: &Topology<V>, p: V) -> [usize; 3] {
+        let mut c = [0usize; 3];
+        for (axis, slot) in c.iter_mut().enumerate().take(V::DIM) {
+            let n = self.dims[axis];
+            if n == 1 {
+                continue;
+            }
+            let f = ((p.get(axis) - topo.min.get(axis)) * self.inv_cell[axis]).floor();
+            *slot = if self.wrap[axis] {
+                (f as i64).rem_euclid(n as i64) as usize
+            } else if f <= 0.0 {
+                0
+            } else {
+                (f as usize).min(n - 1)
+            };
+        }
+        c
+    }
+
+    #[inline]
+    fn key(&self, c: [usize; 3]) -> usize {
+        c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
+    }
+
+    /// The cell at offset `o` from `c`, if it exists.
+    #[inline]
+    fn neighbour(&self, c: [usize; 3], o: [i32; 3]) -> Option<usize> {
+        let mut n = [0usize; 3];
+        for axis in 0..3 {
+            let d = self.dims[axis] as i64;
+            let x = c[axis] as i64 + o[axis] as i64;
+            n[axis] = if self.wrap[axis] {
+                x.rem_euclid(d) as usize
+            } else if x < 0 || x >= d {
+                return None;
+            } else {
+                x as usize
+            };
+        }
+        Some(self.key(n))
+    }
+
+    #[inline]
+    fn cell(&self, key: usize) -> &[u32] {
+        &self.sorted[self.start[key] as usize..self.start[key + 1] as usize]
+    }
+
+    /// Offsets to visit: `forward` = only those after (0,0,0) in (z, y, x) order.
+    fn offsets(&self, dim: usize, forward: bool) -> Vec<[i32; 3]> {
+        let range = |axis: usize| -> Vec<i32> {
+            if axis < dim && self.dims[axis] > 1 {
+                vec![-1, 0, 1]
+            } else {
+                vec![0]
+            }
+        };
+        let mut out = Vec::new();
+        for &z in &range(2) {
+            for &y in &range(1) {
+                for &x in &range(0) {
+                    let after = (z, y, x) > (0, 0, 0);
+                    if !forward || after {
+                        out.push([x, y, z]);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The broad phase, with its scratch memory kept between steps.
+#[derive(Default)]
+pub struct BroadPhase {
+    /// Algorithm choice.
+    pub mode: BroadPhaseMode,
+    levels: Vec<Level>,
+    level_of: Vec<u8>,
+    /// Number of bounding-box tests made in the last call.
+    pub tests: u64,
+    /// Number of grid levels used in the last call (0 for the direct loop).
+    pub levels_used: usize,
+}
+
+#[inline]
+fn overlaps<V: Vector>(topo: &Topology<V>, a: &BroadObject<V>, b: &BroadObject<V>) -> bool {
+    if a.is_wall && b.is_wall {
+        return false;
+    }
+    let d = topo.delta(a.center, b.center);
+    for axis in 0..V::DIM {
+        if d.get(axis).abs() > a.half.get(axis) + b.half.get(axis) {
+            return false;
+        }
+    }
+    true
+}
+
+impl BroadPhase {
+    /// A broad phase using `mode`.
+    pub fn new(mode: BroadPhaseMode) -> Self {
+        BroadPhase {
+            mode,
+            ..Default::default()
+        }
+    }
+
+    /// Fills `out` with every pair of objects whose bounding boxes overlap, each pair once, as
+    /// `(slot, slot)`. Deterministic: the order depends only on `objs`.
+    pub fn find_pairs<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+        out.clear();
+        self.tests = 0;
+        let direct = match self.mode {
+            BroadPhaseMode::AllPairs => true,
+            BroadPhaseMode::Grid => false,
+            BroadPhaseMode::Auto => objs.len() <= SMALL_N,
+        };
+        if direct || objs.is_empty() {
+            self.levels_used = 0;
+            self.all_pairs(objs, topo, out);
+        } else {
+            self.grid(objs, topo, out);
+        }
+    }
+
+    fn all_pairs<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+        for (i, a) in objs.iter().enumerate() {
+            for b in &objs[i + 1..] {
+                self.tests += 1;
+                if overlaps(topo, a, b) {
+                    out.push((a.slot, b.slot));
+                }
+            }
+        }
+    }
+
+    fn grid<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+        // Widths, finest width, and each object's level.
+        let width = |o: &BroadObject<V>| {
+            let mut w: f64 = 0.0;
+            for axis in 0..V::DIM {
+                w = w.max(2.0 * o.half.get(axis));
+            }
+            w
+        };
+        let s0 = objs.iter().map(width).fold(f64::INFINITY, f64::min).max(f64::MIN_POSITIVE);
+        self.level_of.clear();
+        let mut top = 0usize;
+        for o in objs {
+            let w = width(o);
+            let mut level = 0usize;
+            if w > s0 {
+                level = (w / s0).log2().ceil().max(0.0) as usize;
+                while w > s0 * (level as f64).exp2() {
+                    level += 1;
+                }
+                level = level.min(63);
+            }
+            top = top.max(level);
+            self.level_of.push(level as u8);
+        }
+        if self.levels.len() < top + 1 {
+            self.levels.resize_with(top + 1, Level::default);
+        }
+        for level in &mut self.levels {
+            level.members.clear();
+        }
+        for (i, &l) in self.level_of.iter().enumerate() {
+            self.levels[l as usize].members.push(i as u32);
+        }
+
+        // Build each non-empty level's grid, finest first, cells never narrower than the level below.
+        let size = topo.size();
+        let mut floor_cell = 0.0f64;
+        let mut used = Vec::new();
+        for l in 0..=top {
+            let level = &mut self.levels[l];
+            if level.members.is_empty() {
+                continue;
+            }
+            used.push(l);
+            let m = level.members.len();
+            let mut cell = (s0 * (l as f64).exp2()).max(floor_cell);
+            let limit = (4 * m).max(64) as f64;
+            loop {
+                let mut cells = 1.0;
+                for axis in 0..3 {
+                    level.wrap[axis] = false;
+                    if axis >= V::DIM {
+                        level.dims[axis] = 1;
+                        level.inv_cell[axis] = 0.0;
+                        continue;
+                    }
+                    let len = size.get(axis);
+                    if topo.wraps() {
+                        let mut n = (len / cell).floor().max(1.0) as usize;
+                        if n < 3 {
+                            n = 1;
+                        }
+                        level.dims[axis] = n;
+                        level.wrap[axis] = n > 1;
+                        level.inv_cell[axis] = n as f64 / len;
+                    } else {
+                        let n = (len / cell).ceil().clamp(1.0, 1e9) as usize;
+                        level.dims[axis] = n;
+                        level.inv_cell[axis] = 1.0 / cell;
+                    }
+                    cells *= level.dims[axis] as f64;
+                }
+                if cells <= limit {
+                    break;
+                }
+                cell *= (cells / limit).powf(1.0 / V::DIM as f64) * 1.01;
+            }
+            floor_cell = cell;
+
+            // Counting sort of the members by cell key.
+            let ncells = level.dims[0] * level.dims[1] * level.dims[2];
+            level.start.clear();
+            level.start.resize(ncells + 1, 0);
+            level.keys.clear();
+            for &i in &level.members {
+                let k = level.key(level.coords(topo, objs[i as usize].center));
+                level.keys.push(k as u32);
+                level.start[k + 1] += 1;
+            }
+            for k in 0..ncells {
+                level.start[k + 1] += level.start[k];
+            }
+            level.sorted.clear();
+            level.sorted.resize(m, 0);
+            let mut fill = level.start.clone();
+            for (j, &i) in level.members.iter().enumerate() {
+                let k = level.keys[j] as usize;
+                level.sorted[fill[k] as usize] = i;
+                fill[k] += 1;
+            }
+        }
+        self.levels_used = used.len();
+
+        // Pairs within each level: own cell, then the forward half of the neighbours.
+        for &l in &used {
+            let level = &self.levels[l];
+            let forward = level.offsets(V::DIM, true);
+            let ncells = level.dims[0] * level.dims[1] * level.dims[2];
+            for key in 0..ncells {
+                let here = level.cell(key);
+                if here.is_empty() {
+                    continue;
+                }
+                let c = [
+                    key % level.dims[0],
+                    (key / level.dims[0]) % level.dims[1],
+                    key / (level.dims[0] * level.dims[1]),
+                ];
+                for (j, &ia) in here.iter().enumerate() {
+                    let a = &objs[ia as usize];
+                    for &ib in &here[j + 1..] {
+                        self.tests += 1;
+                        let b = &objs[ib as usize];
+                        if overlaps(topo, a, b) {
+                            out.push((a.slot, b.slot));
+                        }
+                    }
+                }
+                for &o in &forward {
+                    let Some(nk) = level.neighbour(c, o) else { continue };
+                    let there = level.cell(nk);
+                    for &ia in here {
+                        let a = &objs[ia as usize];
+                        for &ib in there {
+                            self.tests += 1;
+                            let b = &objs[ib as usize];
+                            if overlaps(topo, a, b) {
+                                out.push((a.slot, b.slot));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // Pairs across levels: each object against the 3^D cells around it on every coarser level.
+        for (u, &fine) in used.iter().enumerate() {
+            for &coarse in &used[u + 1..] {
+                let (lo, hi) = self.levels.split_at(coarse);
+                let (fine_level, coarse_level) = (&lo[fine], &hi[0]);
+                let all = coarse_level.offsets(V::DIM, false);
+                for &ia in &fine_level.sorted {
+                    let a = &objs[ia as usize];
+                    let c = coarse_level.coords(topo, a.center);
+                    for &o in &all {
+                        let Some(nk) = coarse_level.neighbour(c, o) else { continue };
+                        for &ib in coarse_level.cell(nk) {
+                            self.tests += 1;
+                            let b = &objs[ib as usize];
+                            if overlaps(topo, a, b) {
+                                out.push((a.slot, b.slot));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::border::Border;
+    use crate::rng::Rng;
+    use glam::{DVec2, DVec3};
+
+    fn brute<V: Vector>(objs: &[BroadObject<V>], topo: &Topology<V>) -> Vec<(u32, u32)> {
+        let mut bp = BroadPhase::new(BroadPhaseMode::AllPairs);
+        let mut out = Vec::new();
+        bp.find_pairs(objs, topo, &mut out);
+        normalise(out)
+    }
+
+    fn normalise(mut pairs: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+        for p in &mut pairs {
+            if p.0 > p.1 {
+                *p = (p.1, p.0);
+            }
+        }
+        pairs.sort_unstable();
+        pairs
+    }
+
+    fn grid<V: Vector>(objs: &[BroadObject<V>], topo: &Topology<V>) -> Vec<(u32, u32)> {
+        let mut bp = BroadPhase::new(BroadPhaseMode::Grid);
+        let mut out = Vec::new();
+        bp.find_pairs(objs, topo, &mut out);
+        let n = out.len();
+        let pairs = normalise(out);
+        let mut dedup = pairs.clone();
+        dedup.dedup();
+        assert_eq!(dedup.len(), n, "a pair was produced twice");
+        pairs
+    }
+
+    fn random_objs<V: Vector>(rng: &mut Rng, n: usize, size: f64, rmin: f64, rmax: f64) -> Vec<BroadObject<V>> {
+        (0..n)
+            .map(|i| {
+                let mut c = V::zero();
+                for axis in 0..V::DIM {
+                    c.set(axis, rng.uniform(-0.5, size + 0.5));
+                }
+                // log-uniform radii
+                let r = rmin * (rmax / rmin).powf(rng.uniform(0.0, 1.0));
+                BroadObject {
+                    center: c,
+                    half: V::splat(r),
+                    slot: i as u32,
+                    is_wall: false,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn grid_matches_all_pairs_with_varied_radii_in_2d_and_3d() {
+        let mut rng = Rng::new(7);
+        for border in [Border::Bounce, Border::Wrap] {
+            let topo2 = Topology {
+                min: DVec2::ZERO,
+                max: DVec2::splat(40.0),
+                border,
+            };
+            let objs2 = random_objs::<DVec2>(&mut rng, 600, 40.0, 0.2, 6.0);
+            assert_eq!(grid(&objs2, &topo2), brute(&objs2, &topo2));
+            let topo3 = Topology {
+                min: DVec3::ZERO,
+                max: DVec3::splat(15.0),
+                border,
+            };
+            let objs3 = random_objs::<DVec3>(&mut rng, 500, 15.0, 0.1, 3.0);
+            assert_eq!(grid(&objs3, &topo3), brute(&objs3, &topo3));
+        }
+    }
+
+    #[test]
+    fn walls_never_pair_with_walls() {
+        let topo = Topology {
+            min: DVec2::ZERO,
+            max: DVec2::splat(10.0),
+            border: Border::Bounce,
+        };
+        let wall = |slot, x| BroadObject {
+            center: DVec2::new(x, 5.0),
+            half: DVec2::new(0.5, 5.0),
+            slot,
+            is_wall: true,
+        };
+        let objs = vec![wall(0, 1.0), wall(1, 1.5)];
+        assert!(brute(&objs, &topo).is_empty());
+        assert!(grid(&objs, &topo).is_empty());
+    }
+}

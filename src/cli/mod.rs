@@ -1,0 +1,31 @@
+//! The command line: argument definitions and one module per subcommand.
+//!
+//! `src/main.rs` parses, calls [`execute`], and turns the outcome into an exit code.
+
+pub mod run;
+
+use clap::{Parser, Subcommand};
+
+/// critterbox: a sandbox for critters that collide.
+#[derive(Parser, Debug)]
+#[command(name = "critterbox", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do (default: run the default scene).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run a scene headless and print a summary.
+    Run(run::RunArgs),
+}
+
+/// Runs the parsed command line. Output goes to `out`; progress to stderr.
+pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
+    match cli.command {
+        Some(Command::Run(args)) => run::run(&args, out),
+        None => run::run(&run::RunArgs::default(), out),
+    }
+}

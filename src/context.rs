@@ -1,0 +1,278 @@
+//! What a kind's hooks see: the critters involved, the rest of the world read and write, and
+//! queues for structural changes (deaths, spawns) that take effect after the step.
+
+use crate::border::Topology;
+use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::critter_set::CritterSet;
+use crate::kind::{KindId, KindSet};
+use crate::response::{self, Hit};
+use crate::rng::Rng;
+use crate::vector::Vector;
+use std::ops::{Deref, DerefMut};
+
+/// A collision that happened in a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CollisionEvent<V> {
+    /// The critter whose `collide` ran.
+    pub caller: CritterId,
+    /// The other one.
+    pub arg: CritterId,
+    /// Contact point.
+    pub point: V,
+    /// Unit normal from caller to arg.
+    pub normal: V,
+    /// Impulse given to the arg along the normal (0 when they were already separating).
+    pub impulse: f64,
+}
+
+/// Everything that happened in the last step, for summaries and recordings.
+#[derive(Clone, Debug, Default)]
+pub struct StepEvents<V> {
+    /// Default collisions, in the order they were resolved.
+    pub collisions: Vec<CollisionEvent<V>>,
+    /// Critters that died.
+    pub deaths: Vec<CritterId>,
+    /// Critters spawned.
+    pub spawns: Vec<CritterId>,
+    /// Damage taken: (critter, amount).
+    pub damages: Vec<(CritterId, f64)>,
+    /// Lines logged by hooks.
+    pub log: Vec<String>,
+}
+
+impl<V> StepEvents<V> {
+    pub(crate) fn clear(&mut self) {
+        self.collisions.clear();
+        self.deaths.clear();
+        self.spawns.clear();
+        self.damages.clear();
+        self.log.clear();
+    }
+}
+
+/// Spawns waiting for the end of the step.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Pending<V: Vector> {
+    pub spawns: Vec<CritterSpec<V>>,
+    pub deaths: Vec<CritterId>,
+}
+
+/// Read-write access to the world from inside a hook.
+pub struct Access<'a, V: Vector> {
+    pub(crate) critters: &'a mut CritterSet<V>,
+    pub(crate) kinds: &'a KindSet<V>,
+    pub(crate) topo: &'a Topology<V>,
+    pub(crate) pending: &'a mut Pending<V>,
+    pub(crate) events: &'a mut StepEvents<V>,
+    pub(crate) rng: &'a mut Rng,
+    pub(crate) step: u64,
+    pub(crate) time: f64,
+    pub(crate) dt: f64,
+}
+
+impl<V: Vector> Access<'_, V> {
+    /// The critter `id`, if alive or dying this step.
+    pub fn get(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.critters.get(id)
+    }
+    /// The critter `id`, mutably.
+    pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.critters.get_mut(id)
+    }
+    /// The kinds of the world.
+    pub fn kinds(&self) -> &KindSet<V> {
+        self.kinds
+    }
+    /// The world box and border.
+    pub fn topology(&self) -> &Topology<V> {
+        self.topo
+    }
+    /// Steps completed before this one.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+    /// Simulated time at the start of this step.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Time step.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// The world's seeded generator.
+    pub fn rng(&mut self) -> &mut Rng {
+        self.rng
+    }
+    /// True when critter `id` is of kind `kind` or a kind that extends it.
+    pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {
+        self.critters
+            .get(id)
+            .is_some_and(|c| self.kinds.is_kind(c.kind, kind))
+    }
+    /// Live critters of `kind` (or kinds extending it), in id order. O(N).
+    pub fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
+        self.critters
+            .iter()
+            .filter(|c| c.alive && self.kinds.is_kind(c.kind, kind))
+            .map(|c| c.id)
+            .collect()
+    }
+    /// Kills critter `id`: it takes no further collisions and is removed after the step.
+    pub fn die(&mut self, id: CritterId) {
+        if let Some(c) = self.critters.get_mut(id) {
+            if c.alive {
+                c.alive = false;
+                self.pending.deaths.push(id);
+                self.events.deaths.push(id);
+            }
+        }
+    }
+    /// Pop's `damage`: lowers health by `amount`; at or below zero the critter dies.
+    pub fn damage(&mut self, id: CritterId, amount: f64) {
+        let dead = match self.critters.get_mut(id) {
+            Some(c) if c.alive => {
+                c.health -= amount;
+                self.events.damages.push((id, amount));
+                c.health <= 0.0
+            }
+            _ => false,
+        };
+        if dead {
+            self.die(id);
+        }
+    }
+    /// Queues a spawn for the end of the step (checked then, like any spawn).
+    pub fn spawn(&mut self, spec: CritterSpec<V>) {
+        self.pending.spawns.push(spec);
+    }
+    /// Adds a line to the step's log.
+    pub fn log(&mut self, line: impl Into<String>) {
+        self.events.log.push(line.into());
+    }
+    /// `b - a`, through the border when it wraps.
+    pub fn delta(&self, a: V, b: V) -> V {
+        self.topo.delta(a, b)
+    }
+}
+
+/// The context of a `collide` call: `me` is the caller, `other` the arg.
+pub struct CollideCtx<'a, V: Vector> {
+    pub(crate) access: Access<'a, V>,
+    pub(crate) me: u32,
+    pub(crate) other: u32,
+}
+
+impl<'a, V: Vector> Deref for CollideCtx<'a, V> {
+    type Target = Access<'a, V>;
+    fn deref(&self) -> &Access<'a, V> {
+        &self.access
+    }
+}
+
+impl<V: Vector> DerefMut for CollideCtx<'_, V> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.access
+    }
+}
+
+impl<V: Vector> CollideCtx<'_, V> {
+    /// The caller.
+    pub fn me(&self) -> &Critter<V> {
+        self.access.critters.slot(self.me).expect("caller is live during its collide")
+    }
+    /// The arg.
+    pub fn other(&self) -> &Critter<V> {
+        self.access.critters.slot(self.other).expect("arg is live during the collide")
+    }
+    /// Both, mutably: (me, other).
+    pub fn both_mut(&mut self) -> (&mut Critter<V>, &mut Critter<V>) {
+        self.access.critters.pair_mut(self.me, self.other)
+    }
+    /// The caller, mutably.
+    pub fn me_mut(&mut self) -> &mut Critter<V> {
+        self.both_mut().0
+    }
+    /// The arg, mutably.
+    pub fn other_mut(&mut self) -> &mut Critter<V> {
+        self.both_mut().1
+    }
+    /// Distance between the centres (through the border when it wraps).
+    pub fn distance(&self) -> f64 {
+        self.topo.delta(self.me().pos, self.other().pos).length()
+    }
+    /// True when the two touch now.
+    pub fn touches(&self) -> bool {
+        response::contact_between(self.topo, self.me(), self.other()).is_some()
+    }
+    /// Pop's `contains`: the other lies wholly inside me (disks only).
+    pub fn contains(&self) -> bool {
+        let (me, other) = (self.me(), self.other());
+        !me.is_wall()
+            && !other.is_wall()
+            && crate::contact::contains_ball_ball(self.topo.delta(me.pos, other.pos), me.radius, other.radius)
+    }
+    /// The engine's physical response (Pop's `cCritter::collide`). Returns true if they touched.
+    pub fn collide_default(&mut self) -> bool {
+        self.collide_default_hit().is_some()
+    }
+    /// As [`CollideCtx::collide_default`], returning what happened.
+    pub fn collide_default_hit(&mut self) -> Option<Hit<V>> {
+        let topo = self.access.topo;
+        let (me, other) = self.access.critters.pair_mut(self.me, self.other);
+        let hit = response::collide_default(topo, me, other)?;
+        let event = CollisionEvent {
+            caller: me.id,
+            arg: other.id,
+            point: hit.point,
+            normal: hit.normal,
+            impulse: hit.impulse,
+        };
+        self.access.events.collisions.push(event);
+        Some(hit)
+    }
+    /// Kills the caller.
+    pub fn die_me(&mut self) {
+        let id = self.me().id;
+        self.die(id);
+    }
+    /// Kills the arg.
+    pub fn die_other(&mut self) {
+        let id = self.other().id;
+        self.die(id);
+    }
+}
+
+/// The context of an `update` or `init` call.
+pub struct UpdateCtx<'a, V: Vector> {
+    pub(crate) access: Access<'a, V>,
+    pub(crate) me: u32,
+}
+
+impl<'a, V: Vector> Deref for UpdateCtx<'a, V> {
+    type Target = Access<'a, V>;
+    fn deref(&self) -> &Access<'a, V> {
+        &self.access
+    }
+}
+
+impl<V: Vector> DerefMut for UpdateCtx<'_, V> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.access
+    }
+}
+
+impl<V: Vector> UpdateCtx<'_, V> {
+    /// The critter being updated.
+    pub fn me(&self) -> &Critter<V> {
+        self.access.critters.slot(self.me).expect("updated critter is live")
+    }
+    /// The critter being updated, mutably.
+    pub fn me_mut(&mut self) -> &mut Critter<V> {
+        self.access.critters.slot_mut(self.me).expect("updated critter is live")
+    }
+    /// Kills the critter being updated.
+    pub fn die_me(&mut self) {
+        let id = self.me().id;
+        self.die(id);
+    }
+}

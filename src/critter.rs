@@ -1,0 +1,337 @@
+//! Critters: the disks (2D) and spheres (3D) that move and collide, and the walls they bounce off.
+
+use crate::kind::KindId;
+use crate::vector::Vector;
+use crate::wall::WallBox;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// Collide priority of the lowest critters (Pop's CP_MINIMUM).
+pub const CP_MINIMUM: f64 = 0.0;
+/// Collide priority of ordinary critters (Pop's CP_CRITTER).
+pub const CP_CRITTER: f64 = 100.0;
+/// Collide priority of players (Pop's CP_PLAYER).
+pub const CP_PLAYER: f64 = 200.0;
+/// Collide priority of silver bullets (Pop's CP_SILVERBULLET).
+pub const CP_SILVERBULLET: f64 = 300.0;
+/// Collide priority of bullets (Pop's CP_BULLET).
+pub const CP_BULLET: f64 = 400.0;
+/// Collide priority of walls (Pop's CP_WALL).
+pub const CP_WALL: f64 = 500.0;
+/// The highest collide priority (Pop's CP_MAXIMUM).
+pub const CP_MAXIMUM: f64 = 1e6;
+
+/// Pop's priority constants by name, for scripts and command lines.
+pub const PRIORITY_NAMES: [(&str, f64); 7] = [
+    ("CP_MINIMUM", CP_MINIMUM),
+    ("CP_CRITTER", CP_CRITTER),
+    ("CP_PLAYER", CP_PLAYER),
+    ("CP_SILVERBULLET", CP_SILVERBULLET),
+    ("CP_BULLET", CP_BULLET),
+    ("CP_WALL", CP_WALL),
+    ("CP_MAXIMUM", CP_MAXIMUM),
+];
+
+/// A stable critter id: a slot index and the generation of that slot.
+///
+/// When a critter dies its slot may be reused, but with the next generation, so the id of a dead
+/// critter never names a new one. Ids order by index, then generation.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct CritterId {
+    /// Slot index in the world's critter set.
+    pub index: u32,
+    /// How many times the slot has been reused.
+    pub generation: u32,
+}
+
+impl fmt::Debug for CritterId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "#{}", self.index)?;
+        if self.generation > 0 {
+            write!(f, "v{}", self.generation)?;
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for CritterId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self, f)
+    }
+}
+
+/// A user property value, for the map every critter carries.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum PropValue {
+    /// A flag.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A number.
+    Float(f64),
+    /// Some text.
+    Text(String),
+    /// Another critter.
+    Critter(CritterId),
+}
+
+/// A critter's user properties, ordered by name so iteration is deterministic.
+pub type Props = BTreeMap<String, PropValue>;
+
+/// The shape of a critter: a disk (sphere in 3D) of its radius, or a wall box.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape<V: Vector> {
+    /// A disk in 2D, a sphere in 3D.
+    Disk,
+    /// An immovable oriented box (Pop's cCritterWall). Boxed: walls are few, disks are many.
+    Wall(Box<WallBox<V>>),
+}
+
+/// Sentinel for "rule class not yet known" (see [`crate::rules`]).
+pub(crate) const CLASS_UNSET: u32 = u32::MAX;
+
+/// One critter.
+///
+/// Position, velocity, restitution, health and properties are free to change. Radius, mass,
+/// priority and `fixed` go through setters, because the engine caches what follows from them
+/// (inverse mass, the rule class of the pair cache).
+#[derive(Clone, Debug)]
+pub struct Critter<V: Vector> {
+    pub(crate) id: CritterId,
+    pub(crate) kind: KindId,
+    pub(crate) class: u32,
+    /// Centre.
+    pub pos: V,
+    /// Velocity.
+    pub vel: V,
+    pub(crate) radius: f64,
+    pub(crate) mass: f64,
+    pub(crate) inv_mass: f64,
+    pub(crate) priority: f64,
+    /// Coefficient of restitution in [0, 1]; a pair uses the smaller of its two.
+    pub restitution: f64,
+    /// Health; `damage` lowers it and the critter dies at or below zero.
+    pub health: f64,
+    pub(crate) fixed: bool,
+    pub(crate) alive: bool,
+    pub(crate) shape: Shape<V>,
+    /// User properties.
+    pub props: Props,
+}
+
+impl<V: Vector> Critter<V> {
+    /// Stable id.
+    pub fn id(&self) -> CritterId {
+        self.id
+    }
+    /// Kind.
+    pub fn kind(&self) -> KindId {
+        self.kind
+    }
+    /// Radius (for a wall: the radius of its bounding sphere).
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+    /// Mass. Fixed critters have a finite nominal mass but act as infinitely heavy.
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+    /// 1 / mass, or 0 when fixed.
+    pub fn inv_mass(&self) -> f64 {
+        self.inv_mass
+    }
+    /// Collide priority (see `CP_*`).
+    pub fn priority(&self) -> f64 {
+        self.priority
+    }
+    /// Fixed critters have infinite mass: collisions never change their velocity.
+    pub fn is_fixed(&self) -> bool {
+        self.fixed
+    }
+    /// False once the critter has died (it is removed at the end of the step).
+    pub fn is_alive(&self) -> bool {
+        self.alive
+    }
+    /// True for walls.
+    pub fn is_wall(&self) -> bool {
+        matches!(self.shape, Shape::Wall(_))
+    }
+    /// The wall geometry, for walls.
+    pub fn wall(&self) -> Option<&WallBox<V>> {
+        match &self.shape {
+            Shape::Wall(w) => Some(w),
+            Shape::Disk => None,
+        }
+    }
+    /// Shape.
+    pub fn shape(&self) -> &Shape<V> {
+        &self.shape
+    }
+    /// Kinetic energy (zero for fixed critters, which are not part of the dynamics).
+    pub fn kinetic_energy(&self) -> f64 {
+        if self.fixed {
+            0.0
+        } else {
+            0.5 * self.mass * self.vel.length_squared()
+        }
+    }
+
+    /// Sets the radius (finite and > 0). Mass is kept.
+    pub fn set_radius(&mut self, radius: f64) -> Result<(), crate::Error> {
+        check_positive(self.describe(), "radius", radius)?;
+        if self.is_wall() {
+            return Err(crate::Error::InvalidCritter {
+                critter: self.describe(),
+                field: "radius",
+                value: radius.to_string(),
+                reason: "a wall's size is set by its box, not a radius".into(),
+            });
+        }
+        self.radius = radius;
+        Ok(())
+    }
+    /// Sets the mass (finite and > 0).
+    pub fn set_mass(&mut self, mass: f64) -> Result<(), crate::Error> {
+        check_positive(self.describe(), "mass", mass)?;
+        self.mass = mass;
+        self.inv_mass = if self.fixed { 0.0 } else { 1.0 / mass };
+        Ok(())
+    }
+    /// Makes the critter fixed (infinite mass) or free.
+    pub fn set_fixed(&mut self, fixed: bool) {
+        if self.is_wall() {
+            return; // walls are always fixed
+        }
+        self.fixed = fixed;
+        self.inv_mass = if fixed { 0.0 } else { 1.0 / self.mass };
+        self.class = CLASS_UNSET;
+    }
+    /// Sets the collide priority (finite).
+    pub fn set_priority(&mut self, priority: f64) -> Result<(), crate::Error> {
+        if !priority.is_finite() {
+            return Err(crate::Error::InvalidCritter {
+                critter: self.describe(),
+                field: "priority",
+                value: priority.to_string(),
+                reason: "must be a finite number; use the CP_* constants".into(),
+            });
+        }
+        self.priority = priority;
+        self.class = CLASS_UNSET;
+        Ok(())
+    }
+
+    /// "critter #3" — for error messages.
+    pub fn describe(&self) -> String {
+        format!("critter {}", self.id)
+    }
+}
+
+pub(crate) fn check_positive(critter: String, field: &'static str, v: f64) -> Result<(), crate::Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(crate::Error::InvalidCritter {
+            critter,
+            field,
+            value: v.to_string(),
+            reason: "must be a finite number greater than zero".into(),
+        })
+    }
+}
+
+/// How to spawn a critter: its kind by name plus anything that differs from the kind's defaults.
+#[derive(Clone, Debug)]
+pub struct CritterSpec<V: Vector> {
+    /// Kind name (must be registered in the world).
+    pub kind: String,
+    /// Centre.
+    pub pos: V,
+    /// Velocity.
+    pub vel: V,
+    /// Radius; the kind's default when `None`.
+    pub radius: Option<f64>,
+    /// Mass; density x radius^3 when `None`.
+    pub mass: Option<f64>,
+    /// Density; the kind's default when `None`.
+    pub density: Option<f64>,
+    /// Fixed (infinite mass); the kind's default when `None`.
+    pub fixed: Option<bool>,
+    /// Collide priority; the kind's default when `None`.
+    pub priority: Option<f64>,
+    /// Coefficient of restitution; the kind's default when `None`.
+    pub restitution: Option<f64>,
+    /// Health; the kind's default when `None`.
+    pub health: Option<f64>,
+    /// User properties, added to the kind's.
+    pub props: Props,
+}
+
+impl<V: Vector> CritterSpec<V> {
+    /// A critter of `kind` at `pos`, at rest, with the kind's defaults.
+    pub fn new(kind: impl Into<String>, pos: V) -> Self {
+        CritterSpec {
+            kind: kind.into(),
+            pos,
+            vel: V::zero(),
+            radius: None,
+            mass: None,
+            density: None,
+            fixed: None,
+            priority: None,
+            restitution: None,
+            health: None,
+            props: Props::new(),
+        }
+    }
+    /// A plain ball.
+    pub fn ball(pos: V) -> Self {
+        Self::new("ball", pos)
+    }
+    /// With velocity `vel`.
+    pub fn vel(mut self, vel: V) -> Self {
+        self.vel = vel;
+        self
+    }
+    /// With radius `r`.
+    pub fn radius(mut self, r: f64) -> Self {
+        self.radius = Some(r);
+        self
+    }
+    /// With mass `m`.
+    pub fn mass(mut self, m: f64) -> Self {
+        self.mass = Some(m);
+        self
+    }
+    /// With density `d` (mass = d x radius^3).
+    pub fn density(mut self, d: f64) -> Self {
+        self.density = Some(d);
+        self
+    }
+    /// Fixed (infinite mass) or not.
+    pub fn fixed(mut self, fixed: bool) -> Self {
+        self.fixed = Some(fixed);
+        self
+    }
+    /// With collide priority `p`.
+    pub fn priority(mut self, p: f64) -> Self {
+        self.priority = Some(p);
+        self
+    }
+    /// With restitution `e`.
+    pub fn restitution(mut self, e: f64) -> Self {
+        self.restitution = Some(e);
+        self
+    }
+    /// With health `h`.
+    pub fn health(mut self, h: f64) -> Self {
+        self.health = Some(h);
+        self
+    }
+    /// With user property `name` = `value`.
+    pub fn prop(mut self, name: impl Into<String>, value: PropValue) -> Self {
+        self.props.insert(name.into(), value);
+        self
+    }
+}

@@ -1,0 +1,141 @@
+//! Storage for critters: slots addressed by generational ids, O(1) insert and remove.
+//!
+//! A removed critter's slot goes on a free list and is reused with the next generation, so ids
+//! stay stable and a dead critter's id never names a new one. Iteration is in slot order:
+//! deterministic, whatever was added or removed.
+
+use crate::critter::{Critter, CritterId};
+use crate::vector::Vector;
+
+/// The critters of a world.
+#[derive(Clone, Debug)]
+pub struct CritterSet<V: Vector> {
+    slots: Vec<Option<Critter<V>>>,
+    generations: Vec<u32>,
+    free: Vec<u32>,
+    live: usize,
+}
+
+impl<V: Vector> Default for CritterSet<V> {
+    fn default() -> Self {
+        CritterSet {
+            slots: Vec::new(),
+            generations: Vec::new(),
+            free: Vec::new(),
+            live: 0,
+        }
+    }
+}
+
+impl<V: Vector> CritterSet<V> {
+    /// Inserts the critter built by `make` for its new id. O(1) amortised.
+    pub fn insert(&mut self, make: impl FnOnce(CritterId) -> Critter<V>) -> CritterId {
+        let index = match self.free.pop() {
+            Some(i) => i,
+            None => {
+                self.slots.push(None);
+                self.generations.push(0);
+                (self.slots.len() - 1) as u32
+            }
+        };
+        let id = CritterId {
+            index,
+            generation: self.generations[index as usize],
+        };
+        self.slots[index as usize] = Some(make(id));
+        self.live += 1;
+        id
+    }
+
+    /// Removes critter `id`, if it is there. O(1).
+    pub fn remove(&mut self, id: CritterId) -> Option<Critter<V>> {
+        let i = id.index as usize;
+        if self.generations.get(i) != Some(&id.generation) {
+            return None;
+        }
+        let critter = self.slots[i].take()?;
+        self.live -= 1;
+        // A slot whose generation would wrap is retired rather than reused.
+        if let Some(next) = self.generations[i].checked_add(1) {
+            self.generations[i] = next;
+            self.free.push(id.index);
+        }
+        Some(critter)
+    }
+
+    /// The critter with id `id`, if it is still there.
+    #[inline]
+    pub fn get(&self, id: CritterId) -> Option<&Critter<V>> {
+        match self.slots.get(id.index as usize) {
+            Some(Some(c)) if c.id == id => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The critter with id `id`, mutably.
+    #[inline]
+    pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        match self.slots.get_mut(id.index as usize) {
+            Some(Some(c)) if c.id == id => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The critter in slot `index`.
+    #[inline]
+    pub fn slot(&self, index: u32) -> Option<&Critter<V>> {
+        self.slots.get(index as usize).and_then(Option::as_ref)
+    }
+
+    /// The critter in slot `index`, mutably.
+    #[inline]
+    pub fn slot_mut(&mut self, index: u32) -> Option<&mut Critter<V>> {
+        self.slots.get_mut(index as usize).and_then(Option::as_mut)
+    }
+
+    /// Two different occupied slots, both mutably.
+    ///
+    /// # Panics
+    /// If `a == b` or either slot is empty: callers pass slots from this step's pairs.
+    #[inline]
+    pub fn pair_mut(&mut self, a: u32, b: u32) -> (&mut Critter<V>, &mut Critter<V>) {
+        assert_ne!(a, b, "a critter cannot collide with itself");
+        let (a, b) = (a as usize, b as usize);
+        let (first, second) = if a < b {
+            let (lo, hi) = self.slots.split_at_mut(b);
+            (&mut lo[a], &mut hi[0])
+        } else {
+            let (lo, hi) = self.slots.split_at_mut(a);
+            (&mut hi[0], &mut lo[b])
+        };
+        match (first.as_mut(), second.as_mut()) {
+            (Some(x), Some(y)) => (x, y),
+            _ => panic!("pair_mut on an empty slot"),
+        }
+    }
+
+    /// Number of critters.
+    pub fn len(&self) -> usize {
+        self.live
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.live == 0
+    }
+
+    /// Number of slots (live or free): slot indices are below this.
+    pub fn slot_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// The critters, in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = &Critter<V>> {
+        self.slots.iter().filter_map(Option::as_ref)
+    }
+
+    /// The critters, in slot order, mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
+        self.slots.iter_mut().filter_map(Option::as_mut)
+    }
+}

@@ -1,0 +1,89 @@
+//! The library's errors. Each names what is wrong, where, and what to do.
+
+use crate::critter::CritterId;
+
+/// Everything that can go wrong in the library.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A critter's field is out of range.
+    #[error("{critter}: {field} = {value}: {reason}")]
+    InvalidCritter {
+        /// Which critter ("critter #3", or "the ball spawned at (1, 2)").
+        critter: String,
+        /// The field.
+        field: &'static str,
+        /// The bad value.
+        value: String,
+        /// What is wrong and what would be right.
+        reason: String,
+    },
+    /// A wall's geometry is out of range.
+    #[error("wall {field} = {value}: {reason}")]
+    InvalidWall {
+        /// The field.
+        field: &'static str,
+        /// The bad value.
+        value: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A critter would start inside a wall.
+    #[error("{critter} overlaps wall {wall} by {depth:.3}: move it out of the wall (its centre must be at least its radius from every wall)")]
+    SpawnInsideWall {
+        /// Which critter.
+        critter: String,
+        /// The wall.
+        wall: CritterId,
+        /// How deep it overlaps.
+        depth: f64,
+    },
+    /// The world's settings are out of range.
+    #[error("world {field} = {value}: {reason}")]
+    InvalidWorld {
+        /// The field.
+        field: &'static str,
+        /// The bad value.
+        value: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A kind definition is out of range.
+    #[error("kind '{kind}': {reason}")]
+    InvalidKind {
+        /// The kind.
+        kind: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// No kind of that name.
+    #[error("unknown kind '{kind}' (known kinds: {known})")]
+    UnknownKind {
+        /// The name asked for.
+        kind: String,
+        /// The names that exist.
+        known: String,
+    },
+    /// No critter with that id (it died, or never was).
+    #[error("no live critter {0}")]
+    NoSuchCritter(CritterId),
+    /// No built-in scene of that name.
+    #[error("unknown scene '{name}' (built-in scenes: {known}; `critterbox run --list` describes them)")]
+    UnknownScene {
+        /// The name asked for.
+        name: String,
+        /// The names that exist.
+        known: String,
+    },
+    /// A kind's hook failed.
+    #[error("step {step}: kind '{kind}', critter {critter}: {message}")]
+    Hook {
+        /// The kind whose hook failed.
+        kind: String,
+        /// The critter it ran for.
+        critter: CritterId,
+        /// The step.
+        step: u64,
+        /// What went wrong.
+        message: String,
+    },
+}

@@ -1,0 +1,318 @@
+//! Kinds of critter and the one hook trait through which a kind customises behaviour.
+//!
+//! A kind is a name, an optional parent kind (for `is_kind`), default attributes, and an
+//! implementation of [`KindHooks`]. The native behaviour is the trait's default methods, so
+//! `impl KindHooks for ()` is the plain ball; scripted kinds implement the same trait.
+
+use crate::critter::{Critter, CP_CRITTER, CP_WALL};
+use crate::error::Error;
+use crate::vector::Vector;
+use crate::context::{CollideCtx, UpdateCtx};
+use std::collections::BTreeMap;
+use std::rc::Rc;
+
+/// Index of a kind in a world's [`KindSet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct KindId(pub u32);
+
+/// Pop's `collidesWith` answer, from one critter about another.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CollideRule {
+    /// Never collide (Pop's DONTCOLLIDE).
+    DontCollide,
+    /// Collide, and I call `collide` (COLLIDEASCALLER).
+    AsCaller,
+    /// Collide, and the other calls (COLLIDEASARG).
+    AsArg,
+    /// Collide, either may call (COLLIDEEITHERWAY).
+    EitherWay,
+}
+
+impl CollideRule {
+    /// The rule codes by name, as scripts see them.
+    pub const NAMES: [(&'static str, CollideRule); 4] = [
+        ("DONT_COLLIDE", CollideRule::DontCollide),
+        ("COLLIDE_AS_CALLER", CollideRule::AsCaller),
+        ("COLLIDE_AS_ARG", CollideRule::AsArg),
+        ("COLLIDE_EITHER_WAY", CollideRule::EitherWay),
+    ];
+}
+
+/// Pop's default `collidesWith`: two fixed critters don't collide; otherwise the higher priority
+/// calls and equal priorities may go either way.
+pub fn default_collides_with<V: Vector>(me: &Critter<V>, other: &Critter<V>) -> CollideRule {
+    if me.is_fixed() && other.is_fixed() {
+        CollideRule::DontCollide
+    } else if me.priority() > other.priority() {
+        CollideRule::AsCaller
+    } else if me.priority() < other.priority() {
+        CollideRule::AsArg
+    } else {
+        CollideRule::EitherWay
+    }
+}
+
+/// How a kind behaves. Every method has the native default; override what the kind changes.
+///
+/// Hooks get a context that reads and writes the critters involved and queues deaths and
+/// spawns; structural changes take effect after the step.
+pub trait KindHooks<V: Vector> {
+    /// Pop's `collidesWith`: how `me` wants to meet `other`. Asked once per pair of rule classes
+    /// (kind, priority, fixed) and cached, unless [`KindHooks::rule_depends_on_state`] says otherwise.
+    fn collides_with(&self, me: &Critter<V>, other: &Critter<V>) -> CollideRule {
+        default_collides_with(me, other)
+    }
+
+    /// True when `collides_with` reads more than kind, priority and `fixed`, so the answer cannot
+    /// be cached per kind pair.
+    fn rule_depends_on_state(&self) -> bool {
+        false
+    }
+
+    /// Pop's `collide`: called on the caller of a touching pair, once per step. Returns whether the
+    /// pair touched and was handled. The default is the engine's physical response.
+    fn collide(&self, ctx: &mut CollideCtx<'_, V>) -> Result<bool, Error> {
+        Ok(ctx.collide_default())
+    }
+
+    /// Whether [`KindHooks::update`] does anything; kinds without one cost nothing per step.
+    fn has_update(&self) -> bool {
+        false
+    }
+
+    /// Called every step for each live critter of the kind, before it moves.
+    fn update(&self, _ctx: &mut UpdateCtx<'_, V>, _dt: f64) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// Whether [`KindHooks::init`] does anything.
+    fn has_init(&self) -> bool {
+        false
+    }
+
+    /// Called once when a critter of the kind has been spawned.
+    fn init(&self, _ctx: &mut UpdateCtx<'_, V>) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// The native behaviour: plain balls and walls.
+impl<V: Vector> KindHooks<V> for () {}
+
+/// Default attributes of a kind's critters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KindDefaults {
+    /// Radius.
+    pub radius: f64,
+    /// Density: mass = density x radius^3 unless a mass is given.
+    pub density: f64,
+    /// Mass, overriding density when set.
+    pub mass: Option<f64>,
+    /// Collide priority.
+    pub priority: f64,
+    /// Coefficient of restitution.
+    pub restitution: f64,
+    /// Fixed (infinite mass).
+    pub fixed: bool,
+    /// Starting health.
+    pub health: f64,
+}
+
+impl Default for KindDefaults {
+    fn default() -> Self {
+        KindDefaults {
+            radius: 0.5,
+            density: 1.0,
+            mass: None,
+            priority: CP_CRITTER,
+            restitution: 1.0,
+            fixed: false,
+            health: 1.0,
+        }
+    }
+}
+
+/// A registered kind.
+pub struct Kind<V: Vector> {
+    /// Name, unique in the world.
+    pub name: String,
+    /// The kind this one extends, if any.
+    pub parent: Option<KindId>,
+    /// Default attributes.
+    pub defaults: KindDefaults,
+    /// Behaviour.
+    pub hooks: Rc<dyn KindHooks<V>>,
+    pub(crate) has_update: bool,
+    pub(crate) has_init: bool,
+    pub(crate) rule_depends_on_state: bool,
+}
+
+/// The kinds of a world. Always holds `ball` and `wall`.
+pub struct KindSet<V: Vector> {
+    kinds: Vec<Kind<V>>,
+    by_name: BTreeMap<String, KindId>,
+}
+
+/// The kind id of `ball` in every world.
+pub const BALL: KindId = KindId(0);
+/// The kind id of `wall` in every world.
+pub const WALL: KindId = KindId(1);
+
+impl<V: Vector> Default for KindSet<V> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<V: Vector> KindSet<V> {
+    /// The native kinds: `ball` and `wall`.
+    pub fn new() -> Self {
+        let mut set = KindSet {
+            kinds: Vec::new(),
+            by_name: BTreeMap::new(),
+        };
+        set.insert("ball", None, KindDefaults::default(), Rc::new(()));
+        let wall = KindDefaults {
+            priority: CP_WALL,
+            fixed: true,
+            ..KindDefaults::default()
+        };
+        set.insert("wall", None, wall, Rc::new(()));
+        set
+    }
+
+    fn insert(
+        &mut self,
+        name: &str,
+        parent: Option<KindId>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> KindId {
+        let id = KindId(self.kinds.len() as u32);
+        self.by_name.insert(name.to_string(), id);
+        self.kinds.push(Kind {
+            name: name.to_string(),
+            parent,
+            has_update: hooks.has_update(),
+            has_init: hooks.has_init(),
+            rule_depends_on_state: hooks.rule_depends_on_state(),
+            defaults,
+            hooks,
+        });
+        id
+    }
+
+    /// Registers a new kind. Errors if the name is taken, empty, or the parent is unknown, or the
+    /// defaults are out of range.
+    pub fn register(
+        &mut self,
+        name: &str,
+        parent: Option<&str>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Result<KindId, Error> {
+        if name.trim().is_empty() {
+            return Err(Error::InvalidKind {
+                kind: name.to_string(),
+                reason: "a kind needs a non-empty name".into(),
+            });
+        }
+        if self.by_name.contains_key(name) {
+            return Err(Error::InvalidKind {
+                kind: name.to_string(),
+                reason: "a kind of that name is already registered".into(),
+            });
+        }
+        let parent = match parent {
+            Some(p) => Some(self.id(p)?),
+            None => None,
+        };
+        check_defaults(name, &defaults)?;
+        Ok(self.insert(name, parent, defaults, hooks))
+    }
+
+    /// The kind called `name`.
+    pub fn id(&self, name: &str) -> Result<KindId, Error> {
+        self.by_name
+            .get(name)
+            .copied()
+            .ok_or_else(|| Error::UnknownKind {
+                kind: name.to_string(),
+                known: self.by_name.keys().cloned().collect::<Vec<_>>().join(", "),
+            })
+    }
+
+    /// The kind with id `id`.
+    ///
+    /// # Panics
+    /// If `id` did not come from this set.
+    pub fn get(&self, id: KindId) -> &Kind<V> {
+        &self.kinds[id.0 as usize]
+    }
+
+    /// Name of kind `id`.
+    pub fn name(&self, id: KindId) -> &str {
+        &self.get(id).name
+    }
+
+    /// All kinds, in registration order.
+    pub fn iter(&self) -> impl Iterator<Item = (KindId, &Kind<V>)> {
+        self.kinds
+            .iter()
+            .enumerate()
+            .map(|(i, k)| (KindId(i as u32), k))
+    }
+
+    /// Number of kinds.
+    pub fn len(&self) -> usize {
+        self.kinds.len()
+    }
+
+    /// Never true: `ball` and `wall` are always there.
+    pub fn is_empty(&self) -> bool {
+        self.kinds.is_empty()
+    }
+
+    /// True when `kind` is `ancestor` or extends it, directly or not.
+    pub fn is_kind(&self, kind: KindId, ancestor: KindId) -> bool {
+        let mut k = Some(kind);
+        while let Some(id) = k {
+            if id == ancestor {
+                return true;
+            }
+            k = self.get(id).parent;
+        }
+        false
+    }
+}
+
+fn check_defaults(kind: &str, d: &KindDefaults) -> Result<(), Error> {
+    let bad = |reason: String| Error::InvalidKind {
+        kind: kind.to_string(),
+        reason,
+    };
+    if !(d.radius.is_finite() && d.radius > 0.0) {
+        return Err(bad(format!("radius {} must be finite and > 0", d.radius)));
+    }
+    if !(d.density.is_finite() && d.density > 0.0) {
+        return Err(bad(format!("density {} must be finite and > 0", d.density)));
+    }
+    if let Some(m) = d.mass {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(bad(format!("mass {m} must be finite and > 0")));
+        }
+    }
+    if !d.priority.is_finite() {
+        return Err(bad(format!("priority {} must be finite", d.priority)));
+    }
+    if !(0.0..=1.0).contains(&d.restitution) {
+        return Err(bad(format!(
+            "restitution {} must be between 0 and 1",
+            d.restitution
+        )));
+    }
+    if !d.health.is_finite() {
+        return Err(bad(format!("health {} must be finite", d.health)));
+    }
+    Ok(())
+}

@@ -1,0 +1,54 @@
+//! # critterbox
+//!
+//! A sandbox for critters that collide: disks in 2D, spheres in 3D, and walls, with the collide
+//! roles of the Pop game framework (`collides_with` decides who calls, the caller's `collide`
+//! handles the pair) and a physically exact default response.
+//!
+//! ```
+//! use critterbox::{World, WorldConfig, CritterSpec};
+//! use glam::DVec2;
+//!
+//! let mut world = World::new(WorldConfig::new(DVec2::ZERO, DVec2::splat(10.0)))?;
+//! let a = world.spawn(CritterSpec::ball(DVec2::new(3.0, 5.0)).vel(DVec2::new(1.0, 0.0)))?;
+//! let b = world.spawn(CritterSpec::ball(DVec2::new(5.0, 5.0)))?;
+//! world.run(120)?;
+//! // Equal masses, head on: the velocities were swapped.
+//! assert_eq!(world.get(a).unwrap().vel, DVec2::ZERO);
+//! assert_eq!(world.get(b).unwrap().vel, DVec2::new(1.0, 0.0));
+//! # Ok::<(), critterbox::Error>(())
+//! ```
+//!
+//! See `docs/ARCHITECTURE.md` for a map of the modules.
+
+#![warn(missing_docs)]
+
+pub mod border;
+pub mod broad_phase;
+pub mod cli;
+pub mod contact;
+pub mod context;
+pub mod critter;
+pub mod critter_set;
+pub mod error;
+pub mod hash;
+pub mod kind;
+pub mod response;
+pub mod rng;
+pub mod rules;
+pub mod scenes;
+pub mod vector;
+pub mod wall;
+pub mod world;
+
+pub use border::{Border, Topology};
+pub use broad_phase::BroadPhaseMode;
+pub use context::{CollideCtx, CollisionEvent, StepEvents, UpdateCtx};
+pub use critter::{Critter, CritterId, CritterSpec, PropValue, Props, CP_BULLET, CP_CRITTER, CP_MAXIMUM, CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL};
+pub use critter_set::CritterSet;
+pub use error::Error;
+pub use kind::{default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet};
+pub use rng::Rng;
+pub use vector::Vector;
+pub use wall::WallBox;
+pub use world::{StepStats, World, WorldConfig};
+pub use glam;

@@ -1,0 +1,196 @@
+//! The dimension a world lives in.
+//!
+//! Everything in the engine is generic over [`Vector`], implemented for [`DVec2`] (2D scenes) and
+//! [`DVec3`] (3D scenes). A 2D world is a `World<DVec2>`: it stores two floats per position and never
+//! computes a z, so a slow 2D scene does not pay for what a 3D one needs.
+
+use glam::{DMat3, DVec2, DVec3};
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+
+/// A position or velocity in 2D or 3D, f64 throughout.
+pub trait Vector:
+    Copy
+    + Debug
+    + PartialEq
+    + Default
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<f64, Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    /// Number of components: 2 or 3.
+    const DIM: usize;
+    /// An orthonormal frame, used to orient walls: a unit direction in 2D, a rotation matrix in 3D.
+    type Frame: Copy + Debug + PartialEq + Send + Sync;
+
+    /// The zero vector.
+    fn zero() -> Self;
+    /// All components equal to `v`.
+    fn splat(v: f64) -> Self;
+    /// Component `axis` (0 = x, 1 = y, 2 = z).
+    fn get(self, axis: usize) -> f64;
+    /// Sets component `axis`.
+    fn set(&mut self, axis: usize, v: f64);
+    /// Dot product.
+    fn dot(self, other: Self) -> f64;
+    /// True when every component is finite.
+    fn all_finite(self) -> bool;
+    /// The frame whose axes are the world axes.
+    fn identity_frame() -> Self::Frame;
+    /// Axis `axis` of `frame`, in world coordinates.
+    fn frame_axis(frame: &Self::Frame, axis: usize) -> Self;
+    /// The components of `v` along the axes of `frame`.
+    fn to_local(frame: &Self::Frame, v: Self) -> Self;
+    /// The world vector whose components along the axes of `frame` are `v`.
+    fn from_local(frame: &Self::Frame, v: Self) -> Self;
+    /// Components as `[x, y, z]`, with z = 0 in 2D (for printing and recording only).
+    fn to_array3(self) -> [f64; 3];
+
+    /// Squared length.
+    #[inline]
+    fn length_squared(self) -> f64 {
+        self.dot(self)
+    }
+    /// Length.
+    #[inline]
+    fn length(self) -> f64 {
+        self.dot(self).sqrt()
+    }
+    /// The unit vector along x: the deterministic normal used when two centres coincide.
+    #[inline]
+    fn unit_x() -> Self {
+        let mut v = Self::zero();
+        v.set(0, 1.0);
+        v
+    }
+}
+
+impl Vector for DVec2 {
+    const DIM: usize = 2;
+    type Frame = DVec2;
+
+    #[inline]
+    fn zero() -> Self {
+        DVec2::ZERO
+    }
+    #[inline]
+    fn splat(v: f64) -> Self {
+        DVec2::splat(v)
+    }
+    #[inline]
+    fn get(self, axis: usize) -> f64 {
+        self[axis]
+    }
+    #[inline]
+    fn set(&mut self, axis: usize, v: f64) {
+        self[axis] = v;
+    }
+    #[inline]
+    fn dot(self, other: Self) -> f64 {
+        DVec2::dot(self, other)
+    }
+    #[inline]
+    fn all_finite(self) -> bool {
+        self.is_finite()
+    }
+    #[inline]
+    fn identity_frame() -> Self::Frame {
+        DVec2::X
+    }
+    #[inline]
+    fn frame_axis(frame: &Self::Frame, axis: usize) -> Self {
+        if axis == 0 {
+            *frame
+        } else {
+            frame.perp()
+        }
+    }
+    #[inline]
+    fn to_local(frame: &Self::Frame, v: Self) -> Self {
+        DVec2::new(v.dot(*frame), v.dot(frame.perp()))
+    }
+    #[inline]
+    fn from_local(frame: &Self::Frame, v: Self) -> Self {
+        *frame * v.x + frame.perp() * v.y
+    }
+    fn to_array3(self) -> [f64; 3] {
+        [self.x, self.y, 0.0]
+    }
+}
+
+impl Vector for DVec3 {
+    const DIM: usize = 3;
+    type Frame = DMat3;
+
+    #[inline]
+    fn zero() -> Self {
+        DVec3::ZERO
+    }
+    #[inline]
+    fn splat(v: f64) -> Self {
+        DVec3::splat(v)
+    }
+    #[inline]
+    fn get(self, axis: usize) -> f64 {
+        self[axis]
+    }
+    #[inline]
+    fn set(&mut self, axis: usize, v: f64) {
+        self[axis] = v;
+    }
+    #[inline]
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+    #[inline]
+    fn all_finite(self) -> bool {
+        self.is_finite()
+    }
+    #[inline]
+    fn identity_frame() -> Self::Frame {
+        DMat3::IDENTITY
+    }
+    #[inline]
+    fn frame_axis(frame: &Self::Frame, axis: usize) -> Self {
+        frame.col(axis)
+    }
+    #[inline]
+    fn to_local(frame: &Self::Frame, v: Self) -> Self {
+        frame.transpose() * v
+    }
+    #[inline]
+    fn from_local(frame: &Self::Frame, v: Self) -> Self {
+        *frame * v
+    }
+    fn to_array3(self) -> [f64; 3] {
+        [self.x, self.y, self.z]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_round_trip_in_2d() {
+        let f = DVec2::new(3.0, 4.0).normalize();
+        let v = DVec2::new(-1.5, 2.25);
+        let back = DVec2::from_local(&f, DVec2::to_local(&f, v));
+        assert!((back - v).length() < 1e-15);
+        assert!(DVec2::frame_axis(&f, 0).dot(DVec2::frame_axis(&f, 1)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn frames_round_trip_in_3d() {
+        let f = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        let v = DVec3::new(-1.5, 2.25, 0.5);
+        let back = DVec3::from_local(&f, DVec3::to_local(&f, v));
+        assert!((back - v).length() < 1e-14);
+    }
+}

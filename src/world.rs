@@ -1,0 +1,810 @@
+//! The world and its step.
+//!
+//! [`World::step`] is a recipe of named stages, each timed:
+//!
+//! 1. **update**: each critter whose kind has an `update` hook runs it;
+//! 2. **move**: gravity, straight-line motion, then the border (bounce, wrap or clamp);
+//! 3. **broad phase**: candidate pairs whose bounding boxes overlap ([`crate::broad_phase`]);
+//! 4. **rules**: Pop's roles per pair from the cached class-pair table ([`crate::rules`]);
+//! 5. **narrow phase**: the pairs that really touch, put in a fixed order (disk pairs by id, then
+//!    pairs with walls, so no separation pushes a critter back into a wall);
+//! 6. **response**: the caller's `collide` hook for each touching pair whose two critters are both
+//!    still alive;
+//! 7. **lifecycle**: the dead are removed, queued spawns are added.
+//!
+//! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
+//! comes from the world's seeded generator, so the same world gives the same bits every run.
+
+use crate::border::{Border, Topology};
+use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode};
+use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
+use crate::contact::contact_wall_ball;
+use crate::critter::{check_positive, Critter, CritterId, CritterSpec, PropValue, Shape, CLASS_UNSET, CP_WALL};
+use crate::critter_set::CritterSet;
+use crate::error::Error;
+use crate::hash::StateHasher;
+use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
+use crate::rng::Rng;
+use crate::rules::{PairRule, RuleCache};
+use crate::vector::Vector;
+use crate::wall::WallBox;
+use std::collections::BTreeMap;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+/// The settings a world is made with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldConfig<V: Vector> {
+    /// Lower corner of the world box.
+    pub min: V,
+    /// Upper corner of the world box.
+    pub max: V,
+    /// What the box's edge does.
+    pub border: Border,
+    /// Uniform acceleration on every free critter.
+    pub gravity: V,
+    /// Time step.
+    pub dt: f64,
+    /// Seed of the world's generator.
+    pub seed: u64,
+    /// Broad-phase algorithm.
+    pub broad_phase: BroadPhaseMode,
+}
+
+impl<V: Vector> WorldConfig<V> {
+    /// A box from `min` to `max`, bouncing border, no gravity, dt = 1/60, seed 0.
+    pub fn new(min: V, max: V) -> Self {
+        WorldConfig {
+            min,
+            max,
+            border: Border::Bounce,
+            gravity: V::zero(),
+            dt: 1.0 / 60.0,
+            seed: 0,
+            broad_phase: BroadPhaseMode::Auto,
+        }
+    }
+    /// With border `b`.
+    pub fn border(mut self, b: Border) -> Self {
+        self.border = b;
+        self
+    }
+    /// With gravity `g`.
+    pub fn gravity(mut self, g: V) -> Self {
+        self.gravity = g;
+        self
+    }
+    /// With time step `dt`.
+    pub fn dt(mut self, dt: f64) -> Self {
+        self.dt = dt;
+        self
+    }
+    /// With seed `seed`.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+    /// With broad-phase algorithm `mode`.
+    pub fn broad_phase(mut self, mode: BroadPhaseMode) -> Self {
+        self.broad_phase = mode;
+        self
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        let bad = |field: &'static str, value: String, reason: &str| {
+            Err(Error::InvalidWorld {
+                field,
+                value,
+                reason: reason.to_string(),
+            })
+        };
+        if !self.min.all_finite() || !self.max.all_finite() {
+            return bad("box", format!("{:?} to {:?}", self.min, self.max), "corners must be finite");
+        }
+        for axis in 0..V::DIM {
+            if !(self.max.get(axis) > self.min.get(axis)) {
+                return bad(
+                    "size",
+                    format!("{:?}", self.max - self.min),
+                    "the world box must have a positive size along every axis",
+                );
+            }
+        }
+        if !self.gravity.all_finite() {
+            return bad("gravity", format!("{:?}", self.gravity), "must be finite");
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad("dt", self.dt.to_string(), "must be finite and greater than zero");
+        }
+        Ok(())
+    }
+}
+
+/// Time spent in each stage and counts from the last step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepStats {
+    /// Update hooks.
+    pub update: Duration,
+    /// Moving and the border.
+    pub moving: Duration,
+    /// Broad phase.
+    pub broad_phase: Duration,
+    /// Roles.
+    pub rules: Duration,
+    /// Narrow phase.
+    pub narrow_phase: Duration,
+    /// Response.
+    pub response: Duration,
+    /// Deaths and spawns.
+    pub lifecycle: Duration,
+    /// Bounding-box tests made by the broad phase.
+    pub pair_tests: u64,
+    /// Candidate pairs from the broad phase.
+    pub candidates: usize,
+    /// Candidate pairs that may collide (roles other than don't-collide).
+    pub ruled: usize,
+    /// Pairs that touched.
+    pub contacts: usize,
+    /// `collide` calls that returned true (touching pairs handled, resting contacts included).
+    pub collisions: usize,
+    /// Default collisions that exchanged an impulse (approaching pairs).
+    pub impacts: usize,
+}
+
+impl StepStats {
+    /// Sum of all stage times.
+    pub fn total(&self) -> Duration {
+        self.update + self.moving + self.broad_phase + self.rules + self.narrow_phase + self.response + self.lifecycle
+    }
+
+    fn add(&mut self, o: &StepStats) {
+        self.update += o.update;
+        self.moving += o.moving;
+        self.broad_phase += o.broad_phase;
+        self.rules += o.rules;
+        self.narrow_phase += o.narrow_phase;
+        self.response += o.response;
+        self.lifecycle += o.lifecycle;
+        self.pair_tests += o.pair_tests;
+        self.candidates += o.candidates;
+        self.ruled += o.ruled;
+        self.contacts += o.contacts;
+        self.collisions += o.collisions;
+        self.impacts += o.impacts;
+    }
+}
+
+/// A world of critters in 2D (`World<DVec2>`) or 3D (`World<DVec3>`).
+pub struct World<V: Vector> {
+    topo: Topology<V>,
+    gravity: V,
+    dt: f64,
+    seed: u64,
+    critters: CritterSet<V>,
+    kinds: KindSet<V>,
+    rules: RuleCache,
+    broad: BroadPhase,
+    walls: Vec<CritterId>,
+    rng: Rng,
+    step_count: u64,
+    pending: Pending<V>,
+    events: StepEvents<V>,
+    stats: StepStats,
+    totals: StepStats,
+    objs: Vec<BroadObject<V>>,
+    candidates: Vec<(u32, u32)>,
+    ruled: Vec<(u32, u32)>,
+    contacts: Vec<(u32, u32)>,
+}
+
+impl<V: Vector> World<V> {
+    /// An empty world. Errors name the bad setting.
+    pub fn new(config: WorldConfig<V>) -> Result<Self, Error> {
+        config.validate()?;
+        Ok(World {
+            topo: Topology {
+                min: config.min,
+                max: config.max,
+                border: config.border,
+            },
+            gravity: config.gravity,
+            dt: config.dt,
+            seed: config.seed,
+            critters: CritterSet::default(),
+            kinds: KindSet::new(),
+            rules: RuleCache::default(),
+            broad: BroadPhase::new(config.broad_phase),
+            walls: Vec::new(),
+            rng: Rng::new(config.seed),
+            step_count: 0,
+            pending: Pending::default(),
+            events: StepEvents::default(),
+            stats: StepStats::default(),
+            totals: StepStats::default(),
+            objs: Vec::new(),
+            candidates: Vec::new(),
+            ruled: Vec::new(),
+            contacts: Vec::new(),
+        })
+    }
+
+    // ----- settings and queries -------------------------------------------------------------
+
+    /// The world box and border.
+    pub fn topology(&self) -> &Topology<V> {
+        &self.topo
+    }
+    /// Time step.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// Changes the time step.
+    pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::InvalidWorld {
+                field: "dt",
+                value: dt.to_string(),
+                reason: "must be finite and greater than zero".into(),
+            });
+        }
+        self.dt = dt;
+        Ok(())
+    }
+    /// Gravity.
+    pub fn gravity(&self) -> V {
+        self.gravity
+    }
+    /// The seed the world was made with.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+    /// The world's seeded generator (for scene setup).
+    pub fn rng(&mut self) -> &mut Rng {
+        &mut self.rng
+    }
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+    /// Simulated time: steps x dt.
+    pub fn time(&self) -> f64 {
+        self.step_count as f64 * self.dt
+    }
+    /// The critters.
+    pub fn critters(&self) -> &CritterSet<V> {
+        &self.critters
+    }
+    /// Critter `id`.
+    pub fn get(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.critters.get(id)
+    }
+    /// Critter `id`, mutably.
+    pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.critters.get_mut(id)
+    }
+    /// The kinds.
+    pub fn kinds(&self) -> &KindSet<V> {
+        &self.kinds
+    }
+    /// What happened in the last step.
+    pub fn events(&self) -> &StepEvents<V> {
+        &self.events
+    }
+    /// Stage times and counts of the last step.
+    pub fn stats(&self) -> &StepStats {
+        &self.stats
+    }
+    /// Stage times and counts summed over all steps.
+    pub fn totals(&self) -> &StepStats {
+        &self.totals
+    }
+    /// The broad phase's candidate pairs of the last step, as slot indices (diagnostics).
+    pub fn candidate_pairs(&self) -> &[(u32, u32)] {
+        &self.candidates
+    }
+    /// The touching pairs of the last step as (caller, arg) slot indices, in response order.
+    pub fn contact_pairs(&self) -> &[(u32, u32)] {
+        &self.contacts
+    }
+    /// The class-pair rule table (diagnostics: how often roles were computed from hooks).
+    pub fn rule_cache(&self) -> &RuleCache {
+        &self.rules
+    }
+
+    /// Total kinetic energy of the free critters.
+    pub fn kinetic_energy(&self) -> f64 {
+        self.critters.iter().map(Critter::kinetic_energy).sum()
+    }
+    /// Total momentum of the free critters.
+    pub fn momentum(&self) -> V {
+        let mut p = V::zero();
+        for c in self.critters.iter().filter(|c| !c.fixed) {
+            p += c.vel * c.mass;
+        }
+        p
+    }
+    /// Number of live critters of each kind, by name.
+    pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
+        let mut counts = BTreeMap::new();
+        for c in self.critters.iter().filter(|c| c.alive) {
+            *counts.entry(self.kinds.name(c.kind).to_string()).or_insert(0) += 1;
+        }
+        counts
+    }
+    /// Live critters of kind `kind` or kinds that extend it, in id order.
+    pub fn critters_of(&self, kind: &str) -> Result<Vec<CritterId>, Error> {
+        let k = self.kinds.id(kind)?;
+        Ok(self
+            .critters
+            .iter()
+            .filter(|c| c.alive && self.kinds.is_kind(c.kind, k))
+            .map(|c| c.id)
+            .collect())
+    }
+
+    /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
+    /// overwhelming probability) bit-identical worlds.
+    pub fn state_hash(&self) -> u64 {
+        let mut h = StateHasher::default();
+        h.word(self.step_count);
+        h.float(self.dt);
+        for w in self.rng.state() {
+            h.word(w);
+        }
+        for c in self.critters.iter() {
+            h.word(((c.id.index as u64) << 32) | c.id.generation as u64);
+            h.word(((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64);
+            for axis in 0..V::DIM {
+                h.float(c.pos.get(axis));
+                h.float(c.vel.get(axis));
+            }
+            h.float(c.radius);
+            h.float(c.mass);
+            h.float(c.priority);
+            h.float(c.restitution);
+            h.float(c.health);
+            for (name, value) in &c.props {
+                hash_bytes(&mut h, name.as_bytes());
+                match value {
+                    PropValue::Bool(b) => h.word(*b as u64),
+                    PropValue::Int(i) => h.word(*i as u64),
+                    PropValue::Float(x) => h.float(*x),
+                    PropValue::Text(s) => hash_bytes(&mut h, s.as_bytes()),
+                    PropValue::Critter(id) => h.word(((id.index as u64) << 32) | id.generation as u64),
+                }
+            }
+        }
+        h.finish()
+    }
+
+    // ----- building ---------------------------------------------------------------------------
+
+    /// Registers a kind (see [`KindSet::register`]).
+    pub fn register_kind(
+        &mut self,
+        name: &str,
+        parent: Option<&str>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Result<KindId, Error> {
+        self.kinds.register(name, parent, defaults, hooks)
+    }
+
+    /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
+    pub fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
+        wall.validate()?;
+        let center = wall.center;
+        let radius = wall.bounding_radius();
+        let id = self.critters.insert(|id| Critter {
+            id,
+            kind: WALL,
+            class: CLASS_UNSET,
+            pos: center,
+            vel: V::zero(),
+            radius,
+            mass: f64::INFINITY,
+            inv_mass: 0.0,
+            priority: CP_WALL,
+            restitution: 1.0,
+            health: 1.0,
+            fixed: true,
+            alive: true,
+            shape: Shape::Wall(Box::new(wall)),
+            props: Default::default(),
+        });
+        self.walls.push(id);
+        Ok(id)
+    }
+
+    /// Spawns a critter now. Errors name the critter and the bad field; nothing is added then.
+    pub fn spawn(&mut self, spec: CritterSpec<V>) -> Result<CritterId, Error> {
+        let critter = self.build(spec)?;
+        let has_init = self.kinds.get(critter.kind).has_init;
+        let id = self.critters.insert(|id| Critter { id, ..critter });
+        if has_init {
+            self.run_init(id)?;
+        }
+        Ok(id)
+    }
+
+    fn build(&self, spec: CritterSpec<V>) -> Result<Critter<V>, Error> {
+        let kind_id = self.kinds.id(&spec.kind)?;
+        if kind_id == WALL {
+            return Err(Error::InvalidKind {
+                kind: spec.kind,
+                reason: "walls are added with add_wall (they need a box, not a radius)".into(),
+            });
+        }
+        let kind = self.kinds.get(kind_id);
+        let d = &kind.defaults;
+        let who = format!(
+            "the {} spawned at {}",
+            spec.kind,
+            fmt_vec(spec.pos)
+        );
+        if !spec.pos.all_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who,
+                field: "position",
+                value: format!("{:?}", spec.pos),
+                reason: "every coordinate must be a finite number".into(),
+            });
+        }
+        for axis in 0..V::DIM {
+            let x = spec.pos.get(axis);
+            if x < self.topo.min.get(axis) || x > self.topo.max.get(axis) {
+                return Err(Error::InvalidCritter {
+                    critter: who,
+                    field: "position",
+                    value: fmt_vec(spec.pos),
+                    reason: format!(
+                        "outside the world box {} to {}",
+                        fmt_vec(self.topo.min),
+                        fmt_vec(self.topo.max)
+                    ),
+                });
+            }
+        }
+        if !spec.vel.all_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who,
+                field: "velocity",
+                value: format!("{:?}", spec.vel),
+                reason: "every component must be a finite number".into(),
+            });
+        }
+        let radius = spec.radius.unwrap_or(d.radius);
+        check_positive(who.clone(), "radius", radius)?;
+        let density = spec.density.unwrap_or(d.density);
+        check_positive(who.clone(), "density", density)?;
+        let mass = spec.mass.or(if spec.density.is_some() { None } else { d.mass });
+        let mass = mass.unwrap_or(density * radius * radius * radius);
+        check_positive(who.clone(), "mass", mass)?;
+        let restitution = spec.restitution.unwrap_or(d.restitution);
+        if !(0.0..=1.0).contains(&restitution) {
+            return Err(Error::InvalidCritter {
+                critter: who,
+                field: "restitution",
+                value: restitution.to_string(),
+                reason: "must be between 0 (sticky) and 1 (elastic)".into(),
+            });
+        }
+        let priority = spec.priority.unwrap_or(d.priority);
+        if !priority.is_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who,
+                field: "priority",
+                value: priority.to_string(),
+                reason: "must be a finite number; use the CP_* constants".into(),
+            });
+        }
+        let health = spec.health.unwrap_or(d.health);
+        if !health.is_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who,
+                field: "health",
+                value: health.to_string(),
+                reason: "must be a finite number".into(),
+            });
+        }
+        for &wall_id in &self.walls {
+            let Some(wall) = self.critters.get(wall_id) else { continue };
+            let Shape::Wall(geom) = &wall.shape else { continue };
+            let d = self.topo.delta(wall.pos, spec.pos);
+            if let Some(c) = contact_wall_ball(geom, d, radius) {
+                if c.depth > 1e-9 * radius.max(1.0) {
+                    return Err(Error::SpawnInsideWall {
+                        critter: who,
+                        wall: wall_id,
+                        depth: c.depth,
+                    });
+                }
+            }
+        }
+        let fixed = spec.fixed.unwrap_or(d.fixed);
+        Ok(Critter {
+            id: CritterId { index: 0, generation: 0 },
+            kind: kind_id,
+            class: CLASS_UNSET,
+            pos: spec.pos,
+            vel: spec.vel,
+            radius,
+            mass,
+            inv_mass: if fixed { 0.0 } else { 1.0 / mass },
+            priority,
+            restitution,
+            health,
+            fixed,
+            alive: true,
+            shape: Shape::Disk,
+            props: spec.props,
+        })
+    }
+
+    /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
+    pub fn remove(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
+        let c = self.critters.remove(id).ok_or(Error::NoSuchCritter(id))?;
+        if c.is_wall() {
+            self.walls.retain(|&w| w != id);
+        }
+        Ok(c)
+    }
+
+    fn access(&mut self) -> Access<'_, V> {
+        Access {
+            critters: &mut self.critters,
+            kinds: &self.kinds,
+            topo: &self.topo,
+            pending: &mut self.pending,
+            events: &mut self.events,
+            rng: &mut self.rng,
+            step: self.step_count,
+            time: self.step_count as f64 * self.dt,
+            dt: self.dt,
+        }
+    }
+
+    fn run_init(&mut self, id: CritterId) -> Result<(), Error> {
+        let step = self.step_count;
+        let kind = self.critters.get(id).map(|c| c.kind).ok_or(Error::NoSuchCritter(id))?;
+        let hooks = self.kinds.get(kind).hooks.clone();
+        let mut ctx = UpdateCtx {
+            access: self.access(),
+            me: id.index,
+        };
+        hooks.init(&mut ctx).map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+    }
+
+    // ----- the step ---------------------------------------------------------------------------
+
+    /// Advances the world by one time step (see the module docs for the stages).
+    ///
+    /// An error from a hook or a bad queued spawn stops the step where it happened; the world is
+    /// then part-way through that step.
+    pub fn step(&mut self) -> Result<(), Error> {
+        self.events.clear();
+        self.stats = StepStats::default();
+        let mut clock = Instant::now();
+        let mut lap = |slot: &mut Duration| {
+            let now = Instant::now();
+            *slot = now - clock;
+            clock = now;
+        };
+        let mut stats = StepStats::default();
+
+        self.stage_update()?;
+        lap(&mut stats.update);
+        self.stage_move();
+        lap(&mut stats.moving);
+        self.stage_broad_phase();
+        lap(&mut stats.broad_phase);
+        self.stage_rules();
+        lap(&mut stats.rules);
+        self.stage_narrow_phase();
+        lap(&mut stats.narrow_phase);
+        let collisions = self.stage_response()?;
+        lap(&mut stats.response);
+        self.stage_lifecycle()?;
+        lap(&mut stats.lifecycle);
+
+        stats.pair_tests = self.broad.tests;
+        stats.candidates = self.candidates.len();
+        stats.ruled = self.ruled.len();
+        stats.contacts = self.contacts.len();
+        stats.collisions = collisions;
+        stats.impacts = self.events.collisions.iter().filter(|e| e.impulse > 0.0).count();
+        self.stats = stats;
+        self.totals.add(&stats);
+        self.step_count += 1;
+        Ok(())
+    }
+
+    /// Runs `n` steps.
+    pub fn run(&mut self, n: u64) -> Result<(), Error> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn stage_update(&mut self) -> Result<(), Error> {
+        if !self.kinds.iter().any(|(_, k)| k.has_update) {
+            return Ok(());
+        }
+        let dt = self.dt;
+        let step = self.step_count;
+        for index in 0..self.critters.slot_count() as u32 {
+            let Some(c) = self.critters.slot(index) else { continue };
+            if !c.alive || !self.kinds.get(c.kind).has_update {
+                continue;
+            }
+            let (kind, id) = (c.kind, c.id);
+            let hooks = self.kinds.get(kind).hooks.clone();
+            let mut ctx = UpdateCtx {
+                access: self.access(),
+                me: index,
+            };
+            hooks
+                .update(&mut ctx, dt)
+                .map_err(|e| hook_error(e, &self.kinds, kind, id, step))?;
+        }
+        Ok(())
+    }
+
+    fn stage_move(&mut self) {
+        let (dt, g, topo) = (self.dt, self.gravity, self.topo);
+        let dv = g * dt;
+        for c in self.critters.iter_mut() {
+            if !c.alive || c.is_wall() {
+                continue;
+            }
+            if !c.fixed {
+                c.vel += dv;
+            }
+            let moved = c.pos + c.vel * dt;
+            let (pos, vel) = topo.apply(moved, c.vel, c.radius, c.restitution);
+            c.pos = pos;
+            c.vel = vel;
+        }
+    }
+
+    fn stage_broad_phase(&mut self) {
+        self.objs.clear();
+        for c in self.critters.iter_mut() {
+            if !c.alive {
+                continue;
+            }
+            if c.class == CLASS_UNSET {
+                c.class = self.rules.class_of(&self.kinds, c);
+            }
+            let (half, is_wall) = match &c.shape {
+                Shape::Disk => (V::splat(c.radius), false),
+                Shape::Wall(w) => (w.aabb_half(), true),
+            };
+            self.objs.push(BroadObject {
+                center: c.pos,
+                half,
+                slot: c.id.index,
+                is_wall,
+            });
+        }
+        self.broad.find_pairs(&self.objs, &self.topo, &mut self.candidates);
+    }
+
+    fn stage_rules(&mut self) {
+        self.ruled.clear();
+        for &(a, b) in &self.candidates {
+            let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
+                continue;
+            };
+            let pair = match self.rules.rule(&self.kinds, ca, cb) {
+                PairRule::DontCollide => continue,
+                PairRule::FirstCalls => (a, b),
+                PairRule::SecondCalls => (b, a),
+                PairRule::LowerIdCalls if ca.id < cb.id => (a, b),
+                PairRule::LowerIdCalls => (b, a),
+            };
+            self.ruled.push(pair);
+        }
+    }
+
+    fn stage_narrow_phase(&mut self) {
+        self.contacts.clear();
+        let topo = &self.topo;
+        for &(caller, arg) in &self.ruled {
+            let (Some(a), Some(b)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
+                continue;
+            };
+            let touching = match (&a.shape, &b.shape) {
+                (Shape::Disk, Shape::Disk) => {
+                    crate::contact::touching_ball_ball(topo.delta(a.pos, b.pos), a.radius, b.radius)
+                }
+                _ => crate::response::contact_between(topo, a, b).is_some(),
+            };
+            if touching {
+                self.contacts.push((caller, arg));
+            }
+        }
+        // Disk pairs by id, then pairs with a wall, so walls have the last word on positions.
+        let critters = &self.critters;
+        let has_wall = |s: u32| critters.slot(s).is_some_and(Critter::is_wall);
+        self.contacts.sort_unstable_by_key(|&(c, a)| {
+            let wall = has_wall(c) || has_wall(a);
+            (wall, c.min(a), c.max(a))
+        });
+    }
+
+    fn stage_response(&mut self) -> Result<usize, Error> {
+        let mut collisions = 0;
+        let step = self.step_count;
+        let contacts = std::mem::take(&mut self.contacts);
+        let mut result = Ok(());
+        for &(caller, arg) in &contacts {
+            let (Some(c), Some(a)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
+                continue;
+            };
+            if !c.alive || !a.alive {
+                continue;
+            }
+            let (kind, id) = (c.kind, c.id);
+            let hooks = self.kinds.get(kind).hooks.clone();
+            let mut ctx = CollideCtx {
+                access: self.access(),
+                me: caller,
+                other: arg,
+            };
+            match hooks.collide(&mut ctx) {
+                Ok(true) => collisions += 1,
+                Ok(false) => {}
+                Err(e) => {
+                    result = Err(hook_error(e, &self.kinds, kind, id, step));
+                    break;
+                }
+            }
+        }
+        self.contacts = contacts;
+        result.map(|()| collisions)
+    }
+
+    fn stage_lifecycle(&mut self) -> Result<(), Error> {
+        for id in std::mem::take(&mut self.pending.deaths) {
+            if let Some(c) = self.critters.remove(id) {
+                if c.is_wall() {
+                    self.walls.retain(|&w| w != id);
+                }
+            }
+        }
+        for spec in std::mem::take(&mut self.pending.spawns) {
+            let id = self.spawn(spec)?;
+            self.events.spawns.push(id);
+        }
+        Ok(())
+    }
+}
+
+fn hook_error<V: Vector>(e: Error, kinds: &KindSet<V>, kind: KindId, id: CritterId, step: u64) -> Error {
+    match e {
+        Error::Hook { .. } => e,
+        other => Error::Hook {
+            kind: kinds.name(kind).to_string(),
+            critter: id,
+            step,
+            message: other.to_string(),
+        },
+    }
+}
+
+fn hash_bytes(h: &mut StateHasher, bytes: &[u8]) {
+    h.word(bytes.len() as u64);
+    for chunk in bytes.chunks(8) {
+        let mut w = [0u8; 8];
+        w[..chunk.len()].copy_from_slice(chunk);
+        h.word(u64::from_le_bytes(w));
+    }
+}
+
+/// "(1, 2.5)" or "(1, 2.5, 0)".
+pub fn fmt_vec<V: Vector>(v: V) -> String {
+    let parts: Vec<String> = (0..V::DIM).map(|a| format!("{}", v.get(a))).collect();
+    format!("({})", parts.join(", "))
+}
