@@ -17,7 +17,7 @@ use crate::border::Topology;
 use crate::vector::Vector;
 
 /// Below this many objects the direct all-pairs loop is used (see `docs/performance.md`).
-pub const SMALL_N: usize = 48;
+pub const SMALL_N: usize = 100;
 
 /// An object for the broad phase: a centre and per-axis half sizes of its bounding box.
 #[derive(Clone, Copy, Debug)]
@@ -57,6 +57,31 @@ struct Level {
     start: Vec<u32>,
     /// Members ordered by cell.
     sorted: Vec<u32>,
+    /// Cell key of each entry of `sorted`.
+    sorted_keys: Vec<u32>,
+    /// Scratch for the counting sort.
+    fill: Vec<u32>,
+}
+
+/// `i` mod `n` for `i` within one period of `[0, n)`, the general case otherwise.
+#[inline]
+fn wrap_index(i: i64, n: usize) -> usize {
+    let n = n as i64;
+    if i < 0 {
+        if i >= -n {
+            (i + n) as usize
+        } else {
+            i.rem_euclid(n) as usize
+        }
+    } else if i >= n {
+        if i < 2 * n {
+            (i - n) as usize
+        } else {
+            i.rem_euclid(n) as usize
+        }
+    } else {
+        i as usize
+    }
 }
 
 impl Level {
@@ -68,13 +93,17 @@ impl Level {
             if n == 1 {
                 continue;
             }
-            let f = ((p.get(axis) - topo.min.get(axis)) * self.inv_cell[axis]).floor();
-            *slot = if self.wrap[axis] {
-                (f as i64).rem_euclid(n as i64) as usize
-            } else if f <= 0.0 {
-                0
+            let f = (p.get(axis) - topo.min.get(axis)) * self.inv_cell[axis];
+            // Truncation is floor for f >= 0; the rare negative case is handled below.
+            let i = if f >= 0.0 && f < n as f64 {
+                f as i64
             } else {
-                (f as usize).min(n - 1)
+                f.floor().clamp(-1e15, 1e15) as i64
+            };
+            *slot = if self.wrap[axis] {
+                wrap_index(i, n)
+            } else {
+                i.clamp(0, n as i64 - 1) as usize
             };
         }
         c
@@ -93,7 +122,7 @@ impl Level {
             let d = self.dims[axis] as i64;
             let x = c[axis] as i64 + o[axis] as i64;
             n[axis] = if self.wrap[axis] {
-                x.rem_euclid(d) as usize
+                wrap_index(x, self.dims[axis])
             } else if x < 0 || x >= d {
                 return None;
             } else {
@@ -101,6 +130,72 @@ impl Level {
             };
         }
         Some(self.key(n))
+    }
+
+    /// True when every neighbour of `c` exists without wrapping, so keys can be offset directly.
+    #[inline]
+    fn interior(&self, c: [usize; 3]) -> bool {
+        (0..3).all(|axis| self.dims[axis] == 1 || (c[axis] >= 1 && c[axis] + 1 < self.dims[axis]))
+    }
+
+    /// The key offset of cell offset `o` (valid for interior cells).
+    fn key_delta(&self, o: [i32; 3]) -> isize {
+        o[0] as isize
+            + self.dims[0] as isize * (o[1] as isize + self.dims[1] as isize * o[2] as isize)
+    }
+
+    /// Per axis, the first cell and the number of cells of this level whose members may overlap
+    /// the box of `b` (members are at most one cell wide). Never more cells than the axis has.
+    fn footprint<V: Vector>(&self, topo: &Topology<V>, b: &BroadObject<V>) -> [(i64, usize); 3] {
+        let mut out = [(0i64, 1usize); 3];
+        for (axis, slot) in out.iter_mut().enumerate().take(V::DIM) {
+            let n = self.dims[axis];
+            if n == 1 {
+                continue;
+            }
+            let margin = b.half.get(axis) + 0.5 / self.inv_cell[axis];
+            let origin = topo.min.get(axis);
+            let cell_of = |x: f64| {
+                ((x - origin) * self.inv_cell[axis])
+                    .floor()
+                    .clamp(-1e15, 1e15) as i64
+            };
+            let (first, last) = (
+                cell_of(b.center.get(axis) - margin),
+                cell_of(b.center.get(axis) + margin),
+            );
+            *slot = if self.wrap[axis] {
+                if last - first + 1 >= n as i64 {
+                    (0, n)
+                } else {
+                    (first, (last - first + 1) as usize)
+                }
+            } else {
+                let first = first.clamp(0, n as i64 - 1);
+                let last = last.clamp(0, n as i64 - 1);
+                (first, (last - first + 1) as usize)
+            };
+        }
+        out
+    }
+
+    /// Cell index `i` along `axis`, wrapped on periodic axes (in range otherwise).
+    #[inline]
+    fn axis_cell(&self, axis: usize, i: i64) -> usize {
+        if self.wrap[axis] {
+            wrap_index(i, self.dims[axis])
+        } else {
+            i as usize
+        }
+    }
+
+    #[inline]
+    fn decode(&self, key: usize) -> [usize; 3] {
+        let plane = self.dims[0] * self.dims[1];
+        let z = key / plane;
+        let rest = key - z * plane;
+        let y = rest / self.dims[0];
+        [rest - y * self.dims[0], y, z]
     }
 
     #[inline]
@@ -170,7 +265,12 @@ impl BroadPhase {
 
     /// Fills `out` with every pair of objects whose bounding boxes overlap, each pair once, as
     /// `(slot, slot)`. Deterministic: the order depends only on `objs`.
-    pub fn find_pairs<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+    pub fn find_pairs<V: Vector>(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
         out.clear();
         self.tests = 0;
         let direct = match self.mode {
@@ -186,7 +286,12 @@ impl BroadPhase {
         }
     }
 
-    fn all_pairs<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+    fn all_pairs<V: Vector>(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
         for (i, a) in objs.iter().enumerate() {
             for b in &objs[i + 1..] {
                 self.tests += 1;
@@ -197,7 +302,12 @@ impl BroadPhase {
         }
     }
 
-    fn grid<V: Vector>(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+    fn grid<V: Vector>(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
         // Widths, finest width, and each object's level.
         let width = |o: &BroadObject<V>| {
             let mut w: f64 = 0.0;
@@ -206,7 +316,11 @@ impl BroadPhase {
             }
             w
         };
-        let s0 = objs.iter().map(width).fold(f64::INFINITY, f64::min).max(f64::MIN_POSITIVE);
+        let s0 = objs
+            .iter()
+            .map(width)
+            .fold(f64::INFINITY, f64::min)
+            .max(f64::MIN_POSITIVE);
         self.level_of.clear();
         let mut top = 0usize;
         for o in objs {
@@ -244,7 +358,9 @@ impl BroadPhase {
             used.push(l);
             let m = level.members.len();
             let mut cell = (s0 * (l as f64).exp2()).max(floor_cell);
-            let limit = (4 * m).max(64) as f64;
+            // At most ~4 cells per object in the whole scene (not per level: a sparse fine level
+            // must not force coarse cells on the crowded levels above it).
+            let limit = (4 * objs.len()).max(64) as f64;
             loop {
                 let mut cells = 1.0;
                 for axis in 0..3 {
@@ -292,30 +408,36 @@ impl BroadPhase {
             }
             level.sorted.clear();
             level.sorted.resize(m, 0);
-            let mut fill = level.start.clone();
+            level.sorted_keys.clear();
+            level.sorted_keys.resize(m, 0);
+            level.fill.clear();
+            level.fill.extend_from_slice(&level.start[..ncells]);
             for (j, &i) in level.members.iter().enumerate() {
                 let k = level.keys[j] as usize;
-                level.sorted[fill[k] as usize] = i;
-                fill[k] += 1;
+                let at = level.fill[k] as usize;
+                level.sorted[at] = i;
+                level.sorted_keys[at] = k as u32;
+                level.fill[k] += 1;
             }
         }
         self.levels_used = used.len();
 
-        // Pairs within each level: own cell, then the forward half of the neighbours.
+        // Pairs within each level: own cell, then the forward half of the neighbours. Only
+        // occupied cells are visited, walking the cell-sorted members.
         for &l in &used {
             let level = &self.levels[l];
             let forward = level.offsets(V::DIM, true);
-            let ncells = level.dims[0] * level.dims[1] * level.dims[2];
-            for key in 0..ncells {
-                let here = level.cell(key);
-                if here.is_empty() {
-                    continue;
+            let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
+            let m = level.sorted.len();
+            let mut begin = 0;
+            while begin < m {
+                let key = level.sorted_keys[begin] as usize;
+                let mut end = begin + 1;
+                while end < m && level.sorted_keys[end] as usize == key {
+                    end += 1;
                 }
-                let c = [
-                    key % level.dims[0],
-                    (key / level.dims[0]) % level.dims[1],
-                    key / (level.dims[0] * level.dims[1]),
-                ];
+                let here = &level.sorted[begin..end];
+                begin = end;
                 for (j, &ia) in here.iter().enumerate() {
                     let a = &objs[ia as usize];
                     for &ib in &here[j + 1..] {
@@ -326,8 +448,17 @@ impl BroadPhase {
                         }
                     }
                 }
-                for &o in &forward {
-                    let Some(nk) = level.neighbour(c, o) else { continue };
+                let c = level.decode(key);
+                let interior = level.interior(c);
+                for (&o, &delta) in forward.iter().zip(&deltas) {
+                    let nk = if interior {
+                        (key as isize + delta) as usize
+                    } else {
+                        match level.neighbour(c, o) {
+                            Some(nk) => nk,
+                            None => continue,
+                        }
+                    };
                     let there = level.cell(nk);
                     for &ia in here {
                         let a = &objs[ia as usize];
@@ -343,22 +474,63 @@ impl BroadPhase {
             }
         }
 
-        // Pairs across levels: each object against the 3^D cells around it on every coarser level.
+        // Pairs across levels, fine against coarse. Either each fine object looks at the 3^D coarse
+        // cells around it, or each coarse object walks the fine cells its box covers (long walls
+        // over a gas): whichever visits fewer cells, as counted here before doing either.
         for (u, &fine) in used.iter().enumerate() {
             for &coarse in &used[u + 1..] {
                 let (lo, hi) = self.levels.split_at(coarse);
                 let (fine_level, coarse_level) = (&lo[fine], &hi[0]);
-                let all = coarse_level.offsets(V::DIM, false);
-                for &ia in &fine_level.sorted {
-                    let a = &objs[ia as usize];
-                    let c = coarse_level.coords(topo, a.center);
-                    for &o in &all {
-                        let Some(nk) = coarse_level.neighbour(c, o) else { continue };
-                        for &ib in coarse_level.cell(nk) {
-                            self.tests += 1;
-                            let b = &objs[ib as usize];
-                            if overlaps(topo, a, b) {
-                                out.push((a.slot, b.slot));
+                let by_fine = fine_level.sorted.len() as f64 * 3f64.powi(V::DIM as i32);
+                let by_coarse: f64 = coarse_level
+                    .sorted
+                    .iter()
+                    .map(|&ib| {
+                        fine_level
+                            .footprint(topo, &objs[ib as usize])
+                            .iter()
+                            .map(|r| r.1 as f64)
+                            .product::<f64>()
+                    })
+                    .sum();
+                if by_coarse < by_fine {
+                    for &ib in &coarse_level.sorted {
+                        let b = &objs[ib as usize];
+                        let ranges = fine_level.footprint(topo, b);
+                        for k in 0..ranges[2].1 {
+                            for j in 0..ranges[1].1 {
+                                for i in 0..ranges[0].1 {
+                                    let c = [
+                                        fine_level.axis_cell(0, ranges[0].0 + i as i64),
+                                        fine_level.axis_cell(1, ranges[1].0 + j as i64),
+                                        fine_level.axis_cell(2, ranges[2].0 + k as i64),
+                                    ];
+                                    for &ia in fine_level.cell(fine_level.key(c)) {
+                                        self.tests += 1;
+                                        let a = &objs[ia as usize];
+                                        if overlaps(topo, a, b) {
+                                            out.push((a.slot, b.slot));
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                } else {
+                    let all = coarse_level.offsets(V::DIM, false);
+                    for &ia in &fine_level.sorted {
+                        let a = &objs[ia as usize];
+                        let c = coarse_level.coords(topo, a.center);
+                        for &o in &all {
+                            let Some(nk) = coarse_level.neighbour(c, o) else {
+                                continue;
+                            };
+                            for &ib in coarse_level.cell(nk) {
+                                self.tests += 1;
+                                let b = &objs[ib as usize];
+                                if overlaps(topo, a, b) {
+                                    out.push((a.slot, b.slot));
+                                }
                             }
                         }
                     }
@@ -404,7 +576,13 @@ mod tests {
         pairs
     }
 
-    fn random_objs<V: Vector>(rng: &mut Rng, n: usize, size: f64, rmin: f64, rmax: f64) -> Vec<BroadObject<V>> {
+    fn random_objs<V: Vector>(
+        rng: &mut Rng,
+        n: usize,
+        size: f64,
+        rmin: f64,
+        rmax: f64,
+    ) -> Vec<BroadObject<V>> {
         (0..n)
             .map(|i| {
                 let mut c = V::zero();
@@ -441,6 +619,45 @@ mod tests {
             };
             let objs3 = random_objs::<DVec3>(&mut rng, 500, 15.0, 0.1, 3.0);
             assert_eq!(grid(&objs3, &topo3), brute(&objs3, &topo3));
+        }
+    }
+
+    #[test]
+    fn long_walls_over_a_crowd_match_all_pairs() {
+        // Few large objects over many small ones: the coarse objects walk the fine cells.
+        let mut rng = Rng::new(11);
+        for border in [Border::Bounce, Border::Wrap] {
+            let topo = Topology {
+                min: DVec2::ZERO,
+                max: DVec2::splat(60.0),
+                border,
+            };
+            let mut objs = random_objs::<DVec2>(&mut rng, 2000, 60.0, 0.3, 0.5);
+            for (k, (c, h)) in [
+                (DVec2::new(30.0, -0.1), DVec2::new(30.2, 0.1)),
+                (DVec2::new(30.0, 60.1), DVec2::new(30.2, 0.1)),
+                (DVec2::new(-0.1, 30.0), DVec2::new(0.1, 30.2)),
+                (DVec2::new(17.0, 23.0), DVec2::new(9.0, 0.3)),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                objs.push(BroadObject {
+                    center: c,
+                    half: h,
+                    slot: 5000 + k as u32,
+                    is_wall: true,
+                });
+            }
+            let mut bp = BroadPhase::new(BroadPhaseMode::Grid);
+            let mut out = Vec::new();
+            bp.find_pairs(&objs, &topo, &mut out);
+            assert!(
+                bp.tests < 40_000,
+                "walls should not test every disk: {} tests",
+                bp.tests
+            );
+            assert_eq!(grid(&objs, &topo), brute(&objs, &topo));
         }
     }
 

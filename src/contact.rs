@@ -29,7 +29,11 @@ pub fn contact_ball_ball<V: Vector>(d: V, ra: f64, rb: f64) -> Option<Contact<V>
         return None;
     }
     let dist = dist2.sqrt();
-    let normal = if dist > 0.0 { d * (1.0 / dist) } else { V::unit_x() };
+    let normal = if dist > 0.0 {
+        d * (1.0 / dist)
+    } else {
+        V::unit_x()
+    };
     let depth = sum - dist;
     Some(Contact {
         normal,
@@ -127,7 +131,8 @@ mod tests {
 
     #[test]
     fn wall_edge_in_3d() {
-        let wall = WallBox::cuboid(DVec3::ZERO, DVec3::new(2.0, 2.0, 2.0), DMat3::IDENTITY).unwrap();
+        let wall =
+            WallBox::cuboid(DVec3::ZERO, DVec3::new(2.0, 2.0, 2.0), DMat3::IDENTITY).unwrap();
         // Near the edge x = 1, y = 1 (parallel to z).
         let d = DVec3::new(1.3, 1.4, 0.2);
         let c = contact_wall_ball(&wall, d, 0.6).unwrap();

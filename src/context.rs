@@ -178,11 +178,17 @@ impl<V: Vector> DerefMut for CollideCtx<'_, V> {
 impl<V: Vector> CollideCtx<'_, V> {
     /// The caller.
     pub fn me(&self) -> &Critter<V> {
-        self.access.critters.slot(self.me).expect("caller is live during its collide")
+        self.access
+            .critters
+            .slot(self.me)
+            .expect("caller is live during its collide")
     }
     /// The arg.
     pub fn other(&self) -> &Critter<V> {
-        self.access.critters.slot(self.other).expect("arg is live during the collide")
+        self.access
+            .critters
+            .slot(self.other)
+            .expect("arg is live during the collide")
     }
     /// Both, mutably: (me, other).
     pub fn both_mut(&mut self) -> (&mut Critter<V>, &mut Critter<V>) {
@@ -209,7 +215,11 @@ impl<V: Vector> CollideCtx<'_, V> {
         let (me, other) = (self.me(), self.other());
         !me.is_wall()
             && !other.is_wall()
-            && crate::contact::contains_ball_ball(self.topo.delta(me.pos, other.pos), me.radius, other.radius)
+            && crate::contact::contains_ball_ball(
+                self.topo.delta(me.pos, other.pos),
+                me.radius,
+                other.radius,
+            )
     }
     /// The engine's physical response (Pop's `cCritter::collide`). Returns true if they touched.
     pub fn collide_default(&mut self) -> bool {
@@ -264,11 +274,17 @@ impl<V: Vector> DerefMut for UpdateCtx<'_, V> {
 impl<V: Vector> UpdateCtx<'_, V> {
     /// The critter being updated.
     pub fn me(&self) -> &Critter<V> {
-        self.access.critters.slot(self.me).expect("updated critter is live")
+        self.access
+            .critters
+            .slot(self.me)
+            .expect("updated critter is live")
     }
     /// The critter being updated, mutably.
     pub fn me_mut(&mut self) -> &mut Critter<V> {
-        self.access.critters.slot_mut(self.me).expect("updated critter is live")
+        self.access
+            .critters
+            .slot_mut(self.me)
+            .expect("updated critter is live")
     }
     /// Kills the critter being updated.
     pub fn die_me(&mut self) {

@@ -179,7 +179,7 @@ impl<V: Vector> Critter<V> {
 
     /// Sets the radius (finite and > 0). Mass is kept.
     pub fn set_radius(&mut self, radius: f64) -> Result<(), crate::Error> {
-        check_positive(self.describe(), "radius", radius)?;
+        check_positive(|| self.describe(), "radius", radius)?;
         if self.is_wall() {
             return Err(crate::Error::InvalidCritter {
                 critter: self.describe(),
@@ -193,7 +193,7 @@ impl<V: Vector> Critter<V> {
     }
     /// Sets the mass (finite and > 0).
     pub fn set_mass(&mut self, mass: f64) -> Result<(), crate::Error> {
-        check_positive(self.describe(), "mass", mass)?;
+        check_positive(|| self.describe(), "mass", mass)?;
         self.mass = mass;
         self.inv_mass = if self.fixed { 0.0 } else { 1.0 / mass };
         Ok(())
@@ -228,12 +228,16 @@ impl<V: Vector> Critter<V> {
     }
 }
 
-pub(crate) fn check_positive(critter: String, field: &'static str, v: f64) -> Result<(), crate::Error> {
+pub(crate) fn check_positive(
+    critter: impl FnOnce() -> String,
+    field: &'static str,
+    v: f64,
+) -> Result<(), crate::Error> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
         Err(crate::Error::InvalidCritter {
-            critter,
+            critter: critter(),
             field,
             value: v.to_string(),
             reason: "must be a finite number greater than zero".into(),

@@ -67,7 +67,9 @@ pub enum Error {
     #[error("no live critter {0}")]
     NoSuchCritter(CritterId),
     /// No built-in scene of that name.
-    #[error("unknown scene '{name}' (built-in scenes: {known}; `critterbox run --list` describes them)")]
+    #[error(
+        "unknown scene '{name}' (built-in scenes: {known}; `critterbox run --list` describes them)"
+    )]
     UnknownScene {
         /// The name asked for.
         name: String,

@@ -4,10 +4,10 @@
 //! implementation of [`KindHooks`]. The native behaviour is the trait's default methods, so
 //! `impl KindHooks for ()` is the plain ball; scripted kinds implement the same trait.
 
+use crate::context::{CollideCtx, UpdateCtx};
 use crate::critter::{Critter, CP_CRITTER, CP_WALL};
 use crate::error::Error;
 use crate::vector::Vector;
-use crate::context::{CollideCtx, UpdateCtx};
 use std::collections::BTreeMap;
 use std::rc::Rc;
 

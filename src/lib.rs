@@ -43,12 +43,15 @@ pub mod world;
 pub use border::{Border, Topology};
 pub use broad_phase::BroadPhaseMode;
 pub use context::{CollideCtx, CollisionEvent, StepEvents, UpdateCtx};
-pub use critter::{Critter, CritterId, CritterSpec, PropValue, Props, CP_BULLET, CP_CRITTER, CP_MAXIMUM, CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL};
+pub use critter::{
+    Critter, CritterId, CritterSpec, PropValue, Props, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
+    CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
+};
 pub use critter_set::CritterSet;
 pub use error::Error;
+pub use glam;
 pub use kind::{default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet};
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;
 pub use world::{StepStats, World, WorldConfig};
-pub use glam;

@@ -29,7 +29,11 @@ pub struct Hit<V> {
 
 /// The contact between two critters, normal from `a` to `b`; `None` unless they touch.
 #[inline]
-pub fn contact_between<V: Vector>(topo: &Topology<V>, a: &Critter<V>, b: &Critter<V>) -> Option<Contact<V>> {
+pub fn contact_between<V: Vector>(
+    topo: &Topology<V>,
+    a: &Critter<V>,
+    b: &Critter<V>,
+) -> Option<Contact<V>> {
     let d = topo.delta(a.pos, b.pos);
     match (&a.shape, &b.shape) {
         (Shape::Disk, Shape::Disk) => contact_ball_ball(d, a.radius, b.radius),
@@ -72,7 +76,11 @@ pub fn respond<V: Vector>(caller: &mut Critter<V>, arg: &mut Critter<V>, c: &Con
 
 /// Pop's default collide: if the two touch, respond and report what happened.
 #[inline]
-pub fn collide_default<V: Vector>(topo: &Topology<V>, caller: &mut Critter<V>, arg: &mut Critter<V>) -> Option<Hit<V>> {
+pub fn collide_default<V: Vector>(
+    topo: &Topology<V>,
+    caller: &mut Critter<V>,
+    arg: &mut Critter<V>,
+) -> Option<Hit<V>> {
     let c = contact_between(topo, caller, arg)?;
     let point = caller.pos + c.point;
     let impulse = respond(caller, arg, &c);

@@ -42,7 +42,12 @@ impl PairRule {
 /// other asks to be the argument. When exactly one side gets to call, it calls; when neither or
 /// both do (either way, or a conflict), the higher priority calls, and at equal priority the lower
 /// id.
-pub fn resolve_roles(a_says: CollideRule, b_says: CollideRule, a_priority: f64, b_priority: f64) -> PairRule {
+pub fn resolve_roles(
+    a_says: CollideRule,
+    b_says: CollideRule,
+    a_priority: f64,
+    b_priority: f64,
+) -> PairRule {
     use CollideRule::*;
     if a_says == DontCollide || b_says == DontCollide {
         return PairRule::DontCollide;
@@ -101,10 +106,12 @@ impl RuleCache {
         let n = self.uncached.len();
         let class = n as u32;
         self.index.insert(key, class);
-        self.uncached.push(kinds.get(c.kind()).rule_depends_on_state);
+        self.uncached
+            .push(kinds.get(c.kind()).rule_depends_on_state);
         let mut table = vec![UNKNOWN; (n + 1) * (n + 1)];
         for row in 0..n {
-            table[row * (n + 1)..row * (n + 1) + n].copy_from_slice(&self.table[row * n..row * n + n]);
+            table[row * (n + 1)..row * (n + 1) + n]
+                .copy_from_slice(&self.table[row * n..row * n + n]);
         }
         self.table = table;
         class
@@ -112,7 +119,12 @@ impl RuleCache {
 
     /// The roles of `a` and `b`, whose classes are set.
     #[inline]
-    pub(crate) fn rule<V: Vector>(&mut self, kinds: &KindSet<V>, a: &Critter<V>, b: &Critter<V>) -> PairRule {
+    pub(crate) fn rule<V: Vector>(
+        &mut self,
+        kinds: &KindSet<V>,
+        a: &Critter<V>,
+        b: &Critter<V>,
+    ) -> PairRule {
         let (ca, cb) = (a.class as usize, b.class as usize);
         debug_assert!(a.class != CLASS_UNSET && b.class != CLASS_UNSET);
         if self.uncached[ca] || self.uncached[cb] {
@@ -148,23 +160,53 @@ mod tests {
 
     #[test]
     fn pop_default_roles() {
-        assert_eq!(resolve_roles(AsCaller, AsArg, 500.0, 100.0), PairRule::FirstCalls);
-        assert_eq!(resolve_roles(AsArg, AsCaller, 100.0, 500.0), PairRule::SecondCalls);
-        assert_eq!(resolve_roles(EitherWay, EitherWay, 100.0, 100.0), PairRule::LowerIdCalls);
-        assert_eq!(resolve_roles(DontCollide, AsCaller, 1.0, 2.0), PairRule::DontCollide);
-        assert_eq!(resolve_roles(AsCaller, DontCollide, 1.0, 2.0), PairRule::DontCollide);
+        assert_eq!(
+            resolve_roles(AsCaller, AsArg, 500.0, 100.0),
+            PairRule::FirstCalls
+        );
+        assert_eq!(
+            resolve_roles(AsArg, AsCaller, 100.0, 500.0),
+            PairRule::SecondCalls
+        );
+        assert_eq!(
+            resolve_roles(EitherWay, EitherWay, 100.0, 100.0),
+            PairRule::LowerIdCalls
+        );
+        assert_eq!(
+            resolve_roles(DontCollide, AsCaller, 1.0, 2.0),
+            PairRule::DontCollide
+        );
+        assert_eq!(
+            resolve_roles(AsCaller, DontCollide, 1.0, 2.0),
+            PairRule::DontCollide
+        );
     }
 
     #[test]
     fn a_side_that_asks_to_call_wins_over_either_way() {
-        assert_eq!(resolve_roles(EitherWay, AsCaller, 500.0, 100.0), PairRule::SecondCalls);
-        assert_eq!(resolve_roles(AsArg, EitherWay, 500.0, 100.0), PairRule::SecondCalls);
+        assert_eq!(
+            resolve_roles(EitherWay, AsCaller, 500.0, 100.0),
+            PairRule::SecondCalls
+        );
+        assert_eq!(
+            resolve_roles(AsArg, EitherWay, 500.0, 100.0),
+            PairRule::SecondCalls
+        );
     }
 
     #[test]
     fn conflicts_fall_back_to_priority_then_id() {
-        assert_eq!(resolve_roles(AsCaller, AsCaller, 100.0, 200.0), PairRule::SecondCalls);
-        assert_eq!(resolve_roles(AsArg, AsArg, 300.0, 200.0), PairRule::FirstCalls);
-        assert_eq!(resolve_roles(AsCaller, AsCaller, 100.0, 100.0), PairRule::LowerIdCalls);
+        assert_eq!(
+            resolve_roles(AsCaller, AsCaller, 100.0, 200.0),
+            PairRule::SecondCalls
+        );
+        assert_eq!(
+            resolve_roles(AsArg, AsArg, 300.0, 200.0),
+            PairRule::FirstCalls
+        );
+        assert_eq!(
+            resolve_roles(AsCaller, AsCaller, 100.0, 100.0),
+            PairRule::LowerIdCalls
+        );
     }
 }

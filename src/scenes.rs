@@ -314,8 +314,14 @@ impl From<World<DVec3>> for AnyWorld {
 
 fn walled_box(world: &mut World<DVec2>, w: f64, h: f64) -> Result<(), Error> {
     let t = DEFAULT_WALL_THICKNESS;
-    world.add_wall(WallBox::aligned(DVec2::new(-t, -t), DVec2::new(w + t, 0.0))?)?;
-    world.add_wall(WallBox::aligned(DVec2::new(-t, h), DVec2::new(w + t, h + t))?)?;
+    world.add_wall(WallBox::aligned(
+        DVec2::new(-t, -t),
+        DVec2::new(w + t, 0.0),
+    )?)?;
+    world.add_wall(WallBox::aligned(
+        DVec2::new(-t, h),
+        DVec2::new(w + t, h + t),
+    )?)?;
     world.add_wall(WallBox::aligned(DVec2::new(-t, 0.0), DVec2::new(0.0, h))?)?;
     world.add_wall(WallBox::aligned(DVec2::new(w, 0.0), DVec2::new(w + t, h))?)?;
     Ok(())
@@ -335,7 +341,10 @@ fn billiards(p: &SceneParams) -> Result<AnyWorld, Error> {
     for row in 0..5 {
         for k in 0..=row {
             let pos = apex
-                + DVec2::new(row as f64 * gap * (3f64.sqrt() / 2.0), (k as f64 - row as f64 / 2.0) * gap);
+                + DVec2::new(
+                    row as f64 * gap * (3f64.sqrt() / 2.0),
+                    (k as f64 - row as f64 / 2.0) * gap,
+                );
             world.spawn(CritterSpec::ball(pos).radius(r).restitution(e))?;
         }
     }
@@ -353,11 +362,18 @@ fn billiards(p: &SceneParams) -> Result<AnyWorld, Error> {
 fn cradle(p: &SceneParams) -> Result<AnyWorld, Error> {
     let r = 0.5;
     let n = p.n.unwrap_or(5);
-    let config = WorldConfig::new(DVec2::ZERO, DVec2::new(10.0 + 2.0 * r * n as f64 + 10.0, 4.0))
-        .dt(p.dt.unwrap_or(1.0 / 60.0))
-        .seed(p.seed);
+    let config = WorldConfig::new(
+        DVec2::ZERO,
+        DVec2::new(10.0 + 2.0 * r * n as f64 + 10.0, 4.0),
+    )
+    .dt(p.dt.unwrap_or(1.0 / 60.0))
+    .seed(p.seed);
     let mut world = World::new(config)?;
-    world.spawn(CritterSpec::ball(DVec2::new(2.0, 2.0)).vel(DVec2::new(1.0, 0.0)).radius(r))?;
+    world.spawn(
+        CritterSpec::ball(DVec2::new(2.0, 2.0))
+            .vel(DVec2::new(1.0, 0.0))
+            .radius(r),
+    )?;
     for i in 0..n {
         world.spawn(CritterSpec::ball(DVec2::new(5.0 + 2.0 * r * i as f64, 2.0)).radius(r))?;
     }
@@ -388,7 +404,11 @@ fn pegs(p: &SceneParams) -> Result<AnyWorld, Error> {
         }
     }
     // A sloped floor: a rotated wall, touched at faces, edges and corners.
-    world.add_wall(WallBox::segment(DVec2::new(2.0, 4.0), DVec2::new(18.0, 2.0), 0.3)?)?;
+    world.add_wall(WallBox::segment(
+        DVec2::new(2.0, 4.0),
+        DVec2::new(18.0, 2.0),
+        0.3,
+    )?)?;
     let n = p.n.unwrap_or(200);
     for i in 0..n {
         let x = 1.0 + (i % 30) as f64 * 0.6 + world.rng().uniform(-0.05, 0.05);
@@ -396,7 +416,11 @@ fn pegs(p: &SceneParams) -> Result<AnyWorld, Error> {
         if y > h - 0.5 {
             break;
         }
-        world.spawn(CritterSpec::ball(DVec2::new(x, y)).radius(0.2).restitution(0.8))?;
+        world.spawn(
+            CritterSpec::ball(DVec2::new(x, y))
+                .radius(0.2)
+                .restitution(0.8),
+        )?;
     }
     Ok(world.into())
 }

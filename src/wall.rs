@@ -32,7 +32,11 @@ pub struct ClosestFeature<V> {
 impl<V: Vector> WallBox<V> {
     /// A box with the given centre, half extents and frame. Errors name the bad field.
     pub fn new(center: V, half: V, frame: V::Frame) -> Result<Self, Error> {
-        let wall = WallBox { center, frame, half };
+        let wall = WallBox {
+            center,
+            frame,
+            half,
+        };
         wall.validate()?;
         Ok(wall)
     }
@@ -50,7 +54,11 @@ impl<V: Vector> WallBox<V> {
             reason: reason.to_string(),
         };
         if !self.center.all_finite() {
-            return Err(bad("center", format!("{:?}", self.center), "must be finite"));
+            return Err(bad(
+                "center",
+                format!("{:?}", self.center),
+                "must be finite",
+            ));
         }
         for axis in 0..V::DIM {
             let h = self.half.get(axis);
@@ -64,7 +72,8 @@ impl<V: Vector> WallBox<V> {
             for other in 0..V::DIM {
                 let d = V::frame_axis(&self.frame, axis).dot(V::frame_axis(&self.frame, other));
                 let want = if axis == other { 1.0 } else { 0.0 };
-                if !((d - want).abs() < 1e-9) {
+                let orthonormal = (d - want).abs() < 1e-9; // false for NaN too
+                if !orthonormal {
                     return Err(bad(
                         "orientation",
                         format!("{:?}", self.frame),
@@ -131,7 +140,11 @@ impl<V: Vector> WallBox<V> {
                 best_axis = axis;
             }
         }
-        let sign = if local.get(best_axis) < 0.0 { -1.0 } else { 1.0 };
+        let sign = if local.get(best_axis) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         let mut surface = local;
         surface.set(best_axis, sign * self.half.get(best_axis));
         ClosestFeature {
@@ -154,7 +167,8 @@ impl WallBox<DVec2> {
                 reason: "must be finite".into(),
             });
         }
-        if !(length > 0.0) {
+        let has_length = length > 0.0; // false for NaN too
+        if !has_length {
             return Err(Error::InvalidWall {
                 field: "ends",
                 value: format!("{a:?} to {b:?}"),

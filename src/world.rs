@@ -17,9 +17,11 @@
 
 use crate::border::{Border, Topology};
 use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode};
-use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
 use crate::contact::contact_wall_ball;
-use crate::critter::{check_positive, Critter, CritterId, CritterSpec, PropValue, Shape, CLASS_UNSET, CP_WALL};
+use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
+use crate::critter::{
+    check_positive, Critter, CritterId, CritterSpec, PropValue, Shape, CLASS_UNSET, CP_WALL,
+};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::hash::StateHasher;
@@ -99,10 +101,15 @@ impl<V: Vector> WorldConfig<V> {
             })
         };
         if !self.min.all_finite() || !self.max.all_finite() {
-            return bad("box", format!("{:?} to {:?}", self.min, self.max), "corners must be finite");
+            return bad(
+                "box",
+                format!("{:?} to {:?}", self.min, self.max),
+                "corners must be finite",
+            );
         }
         for axis in 0..V::DIM {
-            if !(self.max.get(axis) > self.min.get(axis)) {
+            let positive = self.max.get(axis) > self.min.get(axis); // false for NaN too
+            if !positive {
                 return bad(
                     "size",
                     format!("{:?}", self.max - self.min),
@@ -114,7 +121,11 @@ impl<V: Vector> WorldConfig<V> {
             return bad("gravity", format!("{:?}", self.gravity), "must be finite");
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad("dt", self.dt.to_string(), "must be finite and greater than zero");
+            return bad(
+                "dt",
+                self.dt.to_string(),
+                "must be finite and greater than zero",
+            );
         }
         Ok(())
     }
@@ -154,7 +165,13 @@ pub struct StepStats {
 impl StepStats {
     /// Sum of all stage times.
     pub fn total(&self) -> Duration {
-        self.update + self.moving + self.broad_phase + self.rules + self.narrow_phase + self.response + self.lifecycle
+        self.update
+            + self.moving
+            + self.broad_phase
+            + self.rules
+            + self.narrow_phase
+            + self.response
+            + self.lifecycle
     }
 
     fn add(&mut self, o: &StepStats) {
@@ -327,7 +344,9 @@ impl<V: Vector> World<V> {
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
         let mut counts = BTreeMap::new();
         for c in self.critters.iter().filter(|c| c.alive) {
-            *counts.entry(self.kinds.name(c.kind).to_string()).or_insert(0) += 1;
+            *counts
+                .entry(self.kinds.name(c.kind).to_string())
+                .or_insert(0) += 1;
         }
         counts
     }
@@ -370,7 +389,9 @@ impl<V: Vector> World<V> {
                     PropValue::Int(i) => h.word(*i as u64),
                     PropValue::Float(x) => h.float(*x),
                     PropValue::Text(s) => hash_bytes(&mut h, s.as_bytes()),
-                    PropValue::Critter(id) => h.word(((id.index as u64) << 32) | id.generation as u64),
+                    PropValue::Critter(id) => {
+                        h.word(((id.index as u64) << 32) | id.generation as u64)
+                    }
                 }
             }
         }
@@ -437,14 +458,10 @@ impl<V: Vector> World<V> {
         }
         let kind = self.kinds.get(kind_id);
         let d = &kind.defaults;
-        let who = format!(
-            "the {} spawned at {}",
-            spec.kind,
-            fmt_vec(spec.pos)
-        );
+        let who = || format!("the {} spawned at {}", spec.kind, fmt_vec(spec.pos));
         if !spec.pos.all_finite() {
             return Err(Error::InvalidCritter {
-                critter: who,
+                critter: who(),
                 field: "position",
                 value: format!("{:?}", spec.pos),
                 reason: "every coordinate must be a finite number".into(),
@@ -454,7 +471,7 @@ impl<V: Vector> World<V> {
             let x = spec.pos.get(axis);
             if x < self.topo.min.get(axis) || x > self.topo.max.get(axis) {
                 return Err(Error::InvalidCritter {
-                    critter: who,
+                    critter: who(),
                     field: "position",
                     value: fmt_vec(spec.pos),
                     reason: format!(
@@ -467,23 +484,25 @@ impl<V: Vector> World<V> {
         }
         if !spec.vel.all_finite() {
             return Err(Error::InvalidCritter {
-                critter: who,
+                critter: who(),
                 field: "velocity",
                 value: format!("{:?}", spec.vel),
                 reason: "every component must be a finite number".into(),
             });
         }
         let radius = spec.radius.unwrap_or(d.radius);
-        check_positive(who.clone(), "radius", radius)?;
+        check_positive(who, "radius", radius)?;
         let density = spec.density.unwrap_or(d.density);
-        check_positive(who.clone(), "density", density)?;
-        let mass = spec.mass.or(if spec.density.is_some() { None } else { d.mass });
+        check_positive(who, "density", density)?;
+        let mass = spec
+            .mass
+            .or(if spec.density.is_some() { None } else { d.mass });
         let mass = mass.unwrap_or(density * radius * radius * radius);
-        check_positive(who.clone(), "mass", mass)?;
+        check_positive(who, "mass", mass)?;
         let restitution = spec.restitution.unwrap_or(d.restitution);
         if !(0.0..=1.0).contains(&restitution) {
             return Err(Error::InvalidCritter {
-                critter: who,
+                critter: who(),
                 field: "restitution",
                 value: restitution.to_string(),
                 reason: "must be between 0 (sticky) and 1 (elastic)".into(),
@@ -492,7 +511,7 @@ impl<V: Vector> World<V> {
         let priority = spec.priority.unwrap_or(d.priority);
         if !priority.is_finite() {
             return Err(Error::InvalidCritter {
-                critter: who,
+                critter: who(),
                 field: "priority",
                 value: priority.to_string(),
                 reason: "must be a finite number; use the CP_* constants".into(),
@@ -501,20 +520,24 @@ impl<V: Vector> World<V> {
         let health = spec.health.unwrap_or(d.health);
         if !health.is_finite() {
             return Err(Error::InvalidCritter {
-                critter: who,
+                critter: who(),
                 field: "health",
                 value: health.to_string(),
                 reason: "must be a finite number".into(),
             });
         }
         for &wall_id in &self.walls {
-            let Some(wall) = self.critters.get(wall_id) else { continue };
-            let Shape::Wall(geom) = &wall.shape else { continue };
+            let Some(wall) = self.critters.get(wall_id) else {
+                continue;
+            };
+            let Shape::Wall(geom) = &wall.shape else {
+                continue;
+            };
             let d = self.topo.delta(wall.pos, spec.pos);
             if let Some(c) = contact_wall_ball(geom, d, radius) {
                 if c.depth > 1e-9 * radius.max(1.0) {
                     return Err(Error::SpawnInsideWall {
-                        critter: who,
+                        critter: who(),
                         wall: wall_id,
                         depth: c.depth,
                     });
@@ -523,7 +546,10 @@ impl<V: Vector> World<V> {
         }
         let fixed = spec.fixed.unwrap_or(d.fixed);
         Ok(Critter {
-            id: CritterId { index: 0, generation: 0 },
+            id: CritterId {
+                index: 0,
+                generation: 0,
+            },
             kind: kind_id,
             class: CLASS_UNSET,
             pos: spec.pos,
@@ -566,13 +592,19 @@ impl<V: Vector> World<V> {
 
     fn run_init(&mut self, id: CritterId) -> Result<(), Error> {
         let step = self.step_count;
-        let kind = self.critters.get(id).map(|c| c.kind).ok_or(Error::NoSuchCritter(id))?;
+        let kind = self
+            .critters
+            .get(id)
+            .map(|c| c.kind)
+            .ok_or(Error::NoSuchCritter(id))?;
         let hooks = self.kinds.get(kind).hooks.clone();
         let mut ctx = UpdateCtx {
             access: self.access(),
             me: id.index,
         };
-        hooks.init(&mut ctx).map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+        hooks
+            .init(&mut ctx)
+            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
     }
 
     // ----- the step ---------------------------------------------------------------------------
@@ -612,7 +644,12 @@ impl<V: Vector> World<V> {
         stats.ruled = self.ruled.len();
         stats.contacts = self.contacts.len();
         stats.collisions = collisions;
-        stats.impacts = self.events.collisions.iter().filter(|e| e.impulse > 0.0).count();
+        stats.impacts = self
+            .events
+            .collisions
+            .iter()
+            .filter(|e| e.impulse > 0.0)
+            .count();
         self.stats = stats;
         self.totals.add(&stats);
         self.step_count += 1;
@@ -634,7 +671,9 @@ impl<V: Vector> World<V> {
         let dt = self.dt;
         let step = self.step_count;
         for index in 0..self.critters.slot_count() as u32 {
-            let Some(c) = self.critters.slot(index) else { continue };
+            let Some(c) = self.critters.slot(index) else {
+                continue;
+            };
             if !c.alive || !self.kinds.get(c.kind).has_update {
                 continue;
             }
@@ -688,7 +727,8 @@ impl<V: Vector> World<V> {
                 is_wall,
             });
         }
-        self.broad.find_pairs(&self.objs, &self.topo, &mut self.candidates);
+        self.broad
+            .find_pairs(&self.objs, &self.topo, &mut self.candidates);
     }
 
     fn stage_rules(&mut self) {
@@ -782,7 +822,13 @@ impl<V: Vector> World<V> {
     }
 }
 
-fn hook_error<V: Vector>(e: Error, kinds: &KindSet<V>, kind: KindId, id: CritterId, step: u64) -> Error {
+fn hook_error<V: Vector>(
+    e: Error,
+    kinds: &KindSet<V>,
+    kind: KindId,
+    id: CritterId,
+    step: u64,
+) -> Error {
     match e {
         Error::Hook { .. } => e,
         other => Error::Hook {

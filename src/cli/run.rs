@@ -37,7 +37,11 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if args.list {
         writeln!(out, "built-in scenes (critterbox run NAME):")?;
         for s in SCENES {
-            let mark = if s.name == DEFAULT_SCENE { " (default)" } else { "" };
+            let mark = if s.name == DEFAULT_SCENE {
+                " (default)"
+            } else {
+                ""
+            };
             writeln!(out, "  {:<10} {}{}", s.name, s.about, mark)?;
         }
         return Ok(());
@@ -45,14 +49,18 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let name = args.scene.as_deref().unwrap_or(DEFAULT_SCENE);
     let info = scenes::find(name)?;
     if let Some(dt) = args.dt {
-        anyhow::ensure!(dt.is_finite() && dt > 0.0, "--dt {dt}: the time step must be a finite number greater than zero");
+        anyhow::ensure!(
+            dt.is_finite() && dt > 0.0,
+            "--dt {dt}: the time step must be a finite number greater than zero"
+        );
     }
     let params = SceneParams {
         n: args.n,
         seed: args.seed,
         dt: args.dt,
     };
-    let mut world = scenes::build(name, &params).with_context(|| format!("building scene '{name}'"))?;
+    let mut world =
+        scenes::build(name, &params).with_context(|| format!("building scene '{name}'"))?;
     let steps = args.steps.unwrap_or(info.default_steps);
 
     let energy0 = world.kinetic_energy();
@@ -103,13 +111,21 @@ fn summary(
     let dim = world.dim();
     let totals = world.totals();
     let energy = world.kinetic_energy();
-    let drift = if energy0 > 0.0 { (energy - energy0) / energy0 } else { 0.0 };
+    let drift = if energy0 > 0.0 {
+        (energy - energy0) / energy0
+    } else {
+        0.0
+    };
     let counts: Vec<String> = world
         .count_by_kind()
         .iter()
         .map(|(k, n)| format!("{k} {n}"))
         .collect();
-    writeln!(out, "scene        {name} ({dim}D, {:?} border)", world.border())?;
+    writeln!(
+        out,
+        "scene        {name} ({dim}D, {:?} border)",
+        world.border()
+    )?;
     writeln!(
         out,
         "steps        {steps} (t = {:.4} s, dt = {:.6} s)",
