@@ -19,7 +19,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub steps: Option<u64>,
     /// Time step in seconds (default: the scene's own).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
     /// Seed of the world's random generator: the same seed gives a bit-identical run.
     #[arg(long, default_value_t = 1)]
