@@ -153,6 +153,45 @@ impl<V: Vector> Access<'_, V> {
     pub fn delta(&self, a: V, b: V) -> V {
         self.topo.delta(a, b)
     }
+    /// Distance between the centres of `a` and `b` (through the border when it wraps).
+    pub fn distance_pair(&self, a: CritterId, b: CritterId) -> Option<f64> {
+        let (a, b) = (self.critters.get(a)?, self.critters.get(b)?);
+        Some(self.topo.delta(a.pos, b.pos).length())
+    }
+    /// True when `a` and `b` touch now.
+    pub fn touches_pair(&self, a: CritterId, b: CritterId) -> bool {
+        match (self.critters.get(a), self.critters.get(b)) {
+            (Some(a), Some(b)) if a.id != b.id => response::contact_between(self.topo, a, b).is_some(),
+            _ => false,
+        }
+    }
+    /// Pop's `contains`: `inner` lies wholly inside `outer` (disks only).
+    pub fn contains_pair(&self, outer: CritterId, inner: CritterId) -> bool {
+        match (self.critters.get(outer), self.critters.get(inner)) {
+            (Some(o), Some(i)) if o.id != i.id && !o.is_wall() && !i.is_wall() => {
+                crate::contact::contains_ball_ball(self.topo.delta(o.pos, i.pos), o.radius, i.radius)
+            }
+            _ => false,
+        }
+    }
+    /// The engine's physical response between `caller` and `arg` (Pop's `cCritter::collide`),
+    /// recorded as a collision event. `None` when they don't touch (or either is gone).
+    pub fn collide_default_pair(&mut self, caller: CritterId, arg: CritterId) -> Option<Hit<V>> {
+        if caller == arg || self.critters.get(caller).is_none() || self.critters.get(arg).is_none() {
+            return None;
+        }
+        let topo = self.topo;
+        let (me, other) = self.critters.pair_mut(caller.index, arg.index);
+        let hit = response::collide_default(topo, me, other)?;
+        self.events.collisions.push(CollisionEvent {
+            caller,
+            arg,
+            point: hit.point,
+            normal: hit.normal,
+            impulse: hit.impulse,
+        });
+        Some(hit)
+    }
 }
 
 /// The context of a `collide` call: `me` is the caller, `other` the arg.
@@ -208,18 +247,11 @@ impl<V: Vector> CollideCtx<'_, V> {
     }
     /// True when the two touch now.
     pub fn touches(&self) -> bool {
-        response::contact_between(self.topo, self.me(), self.other()).is_some()
+        self.access.touches_pair(self.me().id, self.other().id)
     }
     /// Pop's `contains`: the other lies wholly inside me (disks only).
     pub fn contains(&self) -> bool {
-        let (me, other) = (self.me(), self.other());
-        !me.is_wall()
-            && !other.is_wall()
-            && crate::contact::contains_ball_ball(
-                self.topo.delta(me.pos, other.pos),
-                me.radius,
-                other.radius,
-            )
+        self.access.contains_pair(self.me().id, self.other().id)
     }
     /// The engine's physical response (Pop's `cCritter::collide`). Returns true if they touched.
     pub fn collide_default(&mut self) -> bool {
@@ -227,18 +259,8 @@ impl<V: Vector> CollideCtx<'_, V> {
     }
     /// As [`CollideCtx::collide_default`], returning what happened.
     pub fn collide_default_hit(&mut self) -> Option<Hit<V>> {
-        let topo = self.access.topo;
-        let (me, other) = self.access.critters.pair_mut(self.me, self.other);
-        let hit = response::collide_default(topo, me, other)?;
-        let event = CollisionEvent {
-            caller: me.id,
-            arg: other.id,
-            point: hit.point,
-            normal: hit.normal,
-            impulse: hit.impulse,
-        };
-        self.access.events.collisions.push(event);
-        Some(hit)
+        let (me, other) = (self.me().id, self.other().id);
+        self.access.collide_default_pair(me, other)
     }
     /// Kills the caller.
     pub fn die_me(&mut self) {

@@ -74,6 +74,8 @@ pub enum PropValue {
     Text(String),
     /// Another critter.
     Critter(CritterId),
+    /// A list of values.
+    List(Vec<PropValue>),
 }
 
 /// A critter's user properties, ordered by name so iteration is deterministic.

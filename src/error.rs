@@ -76,6 +76,9 @@ pub enum Error {
         /// The names that exist.
         known: String,
     },
+    /// A script failed to compile, load or run.
+    #[error("{0}")]
+    Script(ScriptError),
     /// A kind's hook failed.
     #[error("step {step}: kind '{kind}', critter {critter}: {message}")]
     Hook {
@@ -88,4 +91,77 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+}
+
+/// A script error, located: file, line and column, and which kind, critter and step it ran for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScriptError {
+    /// The script file.
+    pub file: String,
+    /// Line (1-based), when known.
+    pub line: Option<usize>,
+    /// Column (1-based), when known.
+    pub column: Option<usize>,
+    /// The kind whose hook ran.
+    pub kind: Option<String>,
+    /// The hook or function that was running (`collide`, `update`, `on_step`, ...).
+    pub hook: Option<String>,
+    /// The critter the hook ran for.
+    pub critter: Option<CritterId>,
+    /// The step.
+    pub step: Option<u64>,
+    /// What went wrong.
+    pub message: String,
+    /// What to do about it.
+    pub hint: Option<String>,
+}
+
+impl ScriptError {
+    /// An error in `file` with `message`, location unknown.
+    pub fn new(file: impl Into<String>, message: impl Into<String>) -> Self {
+        ScriptError {
+            file: file.into(),
+            line: None,
+            column: None,
+            kind: None,
+            hook: None,
+            critter: None,
+            step: None,
+            message: message.into(),
+            hint: None,
+        }
+    }
+}
+
+impl std::fmt::Display for ScriptError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+            if let Some(col) = self.column {
+                write!(f, ":{col}")?;
+            }
+        }
+        write!(f, ": {}", self.message)?;
+        let mut context = Vec::new();
+        if let Some(kind) = &self.kind {
+            context.push(format!("kind '{kind}'"));
+        }
+        if let Some(hook) = &self.hook {
+            context.push(format!("in {hook}"));
+        }
+        if let Some(c) = self.critter {
+            context.push(format!("critter {c}"));
+        }
+        if let Some(step) = self.step {
+            context.push(format!("step {step}"));
+        }
+        if !context.is_empty() {
+            write!(f, " ({})", context.join(", "))?;
+        }
+        if let Some(hint) = &self.hint {
+            write!(f, "\n  hint: {hint}")?;
+        }
+        Ok(())
+    }
 }

@@ -52,15 +52,28 @@ pub fn default_collides_with<V: Vector>(me: &Critter<V>, other: &Critter<V>) -> 
     }
 }
 
+/// What `collides_with` sees: the two critters, read-only, and the world's kinds and box.
+pub struct RuleCtx<'a, V: Vector> {
+    /// The critter whose kind is asked.
+    pub me: &'a Critter<V>,
+    /// The other one.
+    pub other: &'a Critter<V>,
+    /// The world's kinds (for `is_kind`).
+    pub kinds: &'a KindSet<V>,
+    /// The world box and border.
+    pub topo: &'a crate::border::Topology<V>,
+}
+
 /// How a kind behaves. Every method has the native default; override what the kind changes.
 ///
 /// Hooks get a context that reads and writes the critters involved and queues deaths and
 /// spawns; structural changes take effect after the step.
 pub trait KindHooks<V: Vector> {
-    /// Pop's `collidesWith`: how `me` wants to meet `other`. Asked once per pair of rule classes
-    /// (kind, priority, fixed) and cached, unless [`KindHooks::rule_depends_on_state`] says otherwise.
-    fn collides_with(&self, me: &Critter<V>, other: &Critter<V>) -> CollideRule {
-        default_collides_with(me, other)
+    /// Pop's `collidesWith`: how `ctx.me` wants to meet `ctx.other`. Asked once per pair of rule
+    /// classes (kind, priority, fixed) and cached, unless [`KindHooks::rule_depends_on_state`]
+    /// says otherwise.
+    fn collides_with(&self, ctx: &RuleCtx<'_, V>) -> Result<CollideRule, Error> {
+        Ok(default_collides_with(ctx.me, ctx.other))
     }
 
     /// True when `collides_with` reads more than kind, priority and `fixed`, so the answer cannot
@@ -116,6 +129,10 @@ pub struct KindDefaults {
     pub fixed: bool,
     /// Starting health.
     pub health: f64,
+    /// Display colour (a CSS-style name or `#rrggbb`), for viewers.
+    pub color: Option<String>,
+    /// User properties every critter of the kind starts with.
+    pub props: crate::critter::Props,
 }
 
 impl Default for KindDefaults {
@@ -128,6 +145,8 @@ impl Default for KindDefaults {
             restitution: 1.0,
             fixed: false,
             health: 1.0,
+            color: None,
+            props: Default::default(),
         }
     }
 }

@@ -36,6 +36,7 @@ pub mod response;
 pub mod rng;
 pub mod rules;
 pub mod scenes;
+
 pub mod vector;
 pub mod wall;
 pub mod world;
@@ -48,9 +49,9 @@ pub use critter::{
     CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
 };
 pub use critter_set::CritterSet;
-pub use error::Error;
+pub use error::{Error, ScriptError};
 pub use glam;
-pub use kind::{default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet};
+pub use kind::{default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx};
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;

@@ -9,7 +9,9 @@
 //! [`KindHooks::rule_depends_on_state`]: crate::kind::KindHooks::rule_depends_on_state
 
 use crate::critter::{Critter, CLASS_UNSET};
-use crate::kind::{CollideRule, KindId, KindSet};
+use crate::border::Topology;
+use crate::error::Error;
+use crate::kind::{CollideRule, KindId, KindSet, RuleCtx};
 use crate::vector::Vector;
 use std::collections::BTreeMap;
 
@@ -64,10 +66,27 @@ pub fn resolve_roles(
 }
 
 /// The roles of critters `a` and `b`, asking both kinds' hooks.
-pub fn roles_of<V: Vector>(kinds: &KindSet<V>, a: &Critter<V>, b: &Critter<V>) -> PairRule {
-    let a_says = kinds.get(a.kind()).hooks.collides_with(a, b);
-    let b_says = kinds.get(b.kind()).hooks.collides_with(b, a);
-    resolve_roles(a_says, b_says, a.priority(), b.priority())
+pub fn roles_of<V: Vector>(
+    kinds: &KindSet<V>,
+    topo: &Topology<V>,
+    a: &Critter<V>,
+    b: &Critter<V>,
+) -> Result<PairRule, Error> {
+    let ask = |me: &Critter<V>, other: &Critter<V>| {
+        let ctx = RuleCtx { me, other, kinds, topo };
+        kinds.get(me.kind()).hooks.collides_with(&ctx).map_err(|e| match e {
+            Error::Hook { .. } | Error::Script(_) => e,
+            other_err => Error::Hook {
+                kind: kinds.name(me.kind()).to_string(),
+                critter: me.id(),
+                step: 0,
+                message: other_err.to_string(),
+            },
+        })
+    };
+    let a_says = ask(a, b)?;
+    let b_says = ask(b, a)?;
+    Ok(resolve_roles(a_says, b_says, a.priority(), b.priority()))
 }
 
 const UNKNOWN: u8 = u8::MAX;
@@ -117,29 +136,31 @@ impl RuleCache {
         class
     }
 
-    /// The roles of `a` and `b`, whose classes are set.
+    /// The roles of `a` and `b` (whose classes are set) from the table, or `None` when one of their
+    /// kinds' rules depends on state: then the caller asks the hooks, once it knows the pair touches.
     #[inline]
     pub(crate) fn rule<V: Vector>(
         &mut self,
         kinds: &KindSet<V>,
+        topo: &Topology<V>,
         a: &Critter<V>,
         b: &Critter<V>,
-    ) -> PairRule {
+    ) -> Result<Option<PairRule>, Error> {
         let (ca, cb) = (a.class as usize, b.class as usize);
         debug_assert!(a.class != CLASS_UNSET && b.class != CLASS_UNSET);
         if self.uncached[ca] || self.uncached[cb] {
-            return roles_of(kinds, a, b);
+            return Ok(None);
         }
         let n = self.uncached.len();
         let code = self.table[ca * n + cb];
         if code != UNKNOWN {
-            return decode(code);
+            return Ok(Some(decode(code)));
         }
-        let rule = roles_of(kinds, a, b);
+        let rule = roles_of(kinds, topo, a, b)?;
         self.lookups_computed += 1;
         self.table[ca * n + cb] = encode(rule);
         self.table[cb * n + ca] = encode(rule.swapped());
-        rule
+        Ok(Some(rule))
     }
 
     /// Number of class pairs whose roles were computed from the hooks so far.

@@ -210,7 +210,8 @@ pub struct World<V: Vector> {
     totals: StepStats,
     objs: Vec<BroadObject<V>>,
     candidates: Vec<(u32, u32)>,
-    ruled: Vec<(u32, u32)>,
+    /// (caller, arg, roles still to ask the hooks for)
+    ruled: Vec<(u32, u32, bool)>,
     contacts: Vec<(u32, u32)>,
 }
 
@@ -384,15 +385,7 @@ impl<V: Vector> World<V> {
             h.float(c.health);
             for (name, value) in &c.props {
                 hash_bytes(&mut h, name.as_bytes());
-                match value {
-                    PropValue::Bool(b) => h.word(*b as u64),
-                    PropValue::Int(i) => h.word(*i as u64),
-                    PropValue::Float(x) => h.float(*x),
-                    PropValue::Text(s) => hash_bytes(&mut h, s.as_bytes()),
-                    PropValue::Critter(id) => {
-                        h.word(((id.index as u64) << 32) | id.generation as u64)
-                    }
-                }
+                hash_prop(&mut h, value);
             }
         }
         h.finish()
@@ -563,8 +556,17 @@ impl<V: Vector> World<V> {
             fixed,
             alive: true,
             shape: Shape::Disk,
-            props: spec.props,
+            props: {
+                let mut props = d.props.clone();
+                props.extend(spec.props);
+                props
+            },
         })
+    }
+
+    /// Adds a line to the current step's log (scene scripts between steps).
+    pub fn log_line(&mut self, line: String) {
+        self.events.log.push(line);
     }
 
     /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
@@ -630,9 +632,9 @@ impl<V: Vector> World<V> {
         lap(&mut stats.moving);
         self.stage_broad_phase();
         lap(&mut stats.broad_phase);
-        self.stage_rules();
+        self.stage_rules()?;
         lap(&mut stats.rules);
-        self.stage_narrow_phase();
+        self.stage_narrow_phase()?;
         lap(&mut stats.narrow_phase);
         let collisions = self.stage_response()?;
         lap(&mut stats.response);
@@ -731,28 +733,30 @@ impl<V: Vector> World<V> {
             .find_pairs(&self.objs, &self.topo, &mut self.candidates);
     }
 
-    fn stage_rules(&mut self) {
+    fn stage_rules(&mut self) -> Result<(), Error> {
         self.ruled.clear();
         for &(a, b) in &self.candidates {
             let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
                 continue;
             };
-            let pair = match self.rules.rule(&self.kinds, ca, cb) {
-                PairRule::DontCollide => continue,
-                PairRule::FirstCalls => (a, b),
-                PairRule::SecondCalls => (b, a),
-                PairRule::LowerIdCalls if ca.id < cb.id => (a, b),
-                PairRule::LowerIdCalls => (b, a),
-            };
-            self.ruled.push(pair);
+            match self.rules.rule(&self.kinds, &self.topo, ca, cb).map_err(|e| at_step(e, self.step_count))? {
+                Some(rule) => {
+                    if let Some((caller, arg)) = roles_order(rule, ca, cb) {
+                        self.ruled.push((caller.id.index, arg.id.index, false));
+                    }
+                }
+                // State-dependent rules are asked only for pairs that really touch.
+                None => self.ruled.push((a, b, true)),
+            }
         }
+        Ok(())
     }
 
-    fn stage_narrow_phase(&mut self) {
+    fn stage_narrow_phase(&mut self) -> Result<(), Error> {
         self.contacts.clear();
         let topo = &self.topo;
-        for &(caller, arg) in &self.ruled {
-            let (Some(a), Some(b)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
+        for &(first, second, ask) in &self.ruled {
+            let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
                 continue;
             };
             let touching = match (&a.shape, &b.shape) {
@@ -761,8 +765,16 @@ impl<V: Vector> World<V> {
                 }
                 _ => crate::response::contact_between(topo, a, b).is_some(),
             };
-            if touching {
-                self.contacts.push((caller, arg));
+            if !touching {
+                continue;
+            }
+            if ask {
+                let rule = crate::rules::roles_of(&self.kinds, topo, a, b).map_err(|e| at_step(e, self.step_count))?;
+                if let Some((caller, arg)) = roles_order(rule, a, b) {
+                    self.contacts.push((caller.id.index, arg.id.index));
+                }
+            } else {
+                self.contacts.push((first, second));
             }
         }
         // Disk pairs by id, then pairs with a wall, so walls have the last word on positions.
@@ -772,6 +784,7 @@ impl<V: Vector> World<V> {
             let wall = has_wall(c) || has_wall(a);
             (wall, c.min(a), c.max(a))
         });
+        Ok(())
     }
 
     fn stage_response(&mut self) -> Result<usize, Error> {
@@ -822,6 +835,38 @@ impl<V: Vector> World<V> {
     }
 }
 
+/// Sets the step of a hook error raised where the step was not known.
+fn at_step(e: Error, step: u64) -> Error {
+    match e {
+        Error::Hook { kind, critter, message, .. } => Error::Hook {
+            kind,
+            critter,
+            step,
+            message,
+        },
+        Error::Script(mut s) => {
+            s.step = Some(step);
+            Error::Script(s)
+        }
+        other => other,
+    }
+}
+
+/// (caller, arg) for a pair under `rule`, or `None` when they don't collide.
+fn roles_order<'c, V: Vector>(
+    rule: PairRule,
+    a: &'c Critter<V>,
+    b: &'c Critter<V>,
+) -> Option<(&'c Critter<V>, &'c Critter<V>)> {
+    match rule {
+        PairRule::DontCollide => None,
+        PairRule::FirstCalls => Some((a, b)),
+        PairRule::SecondCalls => Some((b, a)),
+        PairRule::LowerIdCalls if a.id < b.id => Some((a, b)),
+        PairRule::LowerIdCalls => Some((b, a)),
+    }
+}
+
 fn hook_error<V: Vector>(
     e: Error,
     kinds: &KindSet<V>,
@@ -831,12 +876,34 @@ fn hook_error<V: Vector>(
 ) -> Error {
     match e {
         Error::Hook { .. } => e,
+        Error::Script(mut s) => {
+            s.kind.get_or_insert_with(|| kinds.name(kind).to_string());
+            s.critter.get_or_insert(id);
+            s.step.get_or_insert(step);
+            Error::Script(s)
+        }
         other => Error::Hook {
             kind: kinds.name(kind).to_string(),
             critter: id,
             step,
             message: other.to_string(),
         },
+    }
+}
+
+fn hash_prop(h: &mut StateHasher, value: &PropValue) {
+    match value {
+        PropValue::Bool(b) => h.word(*b as u64),
+        PropValue::Int(i) => h.word(*i as u64),
+        PropValue::Float(x) => h.float(*x),
+        PropValue::Text(s) => hash_bytes(h, s.as_bytes()),
+        PropValue::Critter(id) => h.word(((id.index as u64) << 32) | id.generation as u64),
+        PropValue::List(items) => {
+            h.word(items.len() as u64);
+            for item in items {
+                hash_prop(h, item);
+            }
+        }
     }
 }
 
