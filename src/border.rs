@@ -71,6 +71,23 @@ impl<V: Vector> Topology<V> {
         d
     }
 
+    /// `p` mapped back into the box along every axis (for wrapped worlds).
+    #[inline]
+    pub fn wrap_position(&self, mut p: V) -> V {
+        for axis in 0..V::DIM {
+            let (lo, hi) = (self.min.get(axis), self.max.get(axis));
+            let x = p.get(axis);
+            if x < lo || x >= hi {
+                let mut w = lo + (x - lo).rem_euclid(hi - lo);
+                if w >= hi {
+                    w = lo; // rem_euclid can round up to the period
+                }
+                p.set(axis, w);
+            }
+        }
+        p
+    }
+
     /// Applies the border to a disk of radius `r`: returns the new position and velocity.
     ///
     /// Bounce mirrors the position about the edge (exact for straight-line motion) and reflects
@@ -85,12 +102,7 @@ impl<V: Vector> Topology<V> {
             match self.border {
                 Border::Wrap => {
                     if x < lo || x >= hi {
-                        let l = hi - lo;
-                        let mut w = lo + (x - lo).rem_euclid(l);
-                        if w >= hi {
-                            w = lo; // rem_euclid can round up to l
-                        }
-                        pos.set(axis, w);
+                        pos = self.wrap_position(pos);
                     }
                 }
                 Border::Bounce => {

@@ -29,11 +29,8 @@ pub fn contact_ball_ball<V: Vector>(d: V, ra: f64, rb: f64) -> Option<Contact<V>
         return None;
     }
     let dist = dist2.sqrt();
-    let normal = if dist > 0.0 {
-        d * (1.0 / dist)
-    } else {
-        V::unit_x()
-    };
+    // Divide rather than multiply by 1/dist: an axis-aligned offset then gives the exact axis.
+    let normal = if dist > 0.0 { d / dist } else { V::unit_x() };
     let depth = sum - dist;
     Some(Contact {
         normal,
@@ -70,7 +67,7 @@ pub fn contact_wall_ball<V: Vector>(wall: &WallBox<V>, d: V, r: f64) -> Option<C
     }
     let dist = dist2.sqrt();
     let normal = if dist > 0.0 {
-        away * (1.0 / dist)
+        away / dist
     } else {
         // Centre exactly on the surface: take the outward direction of the surface point.
         let inward = wall.closest_feature(feature.offset * (1.0 - 1e-12));

@@ -30,7 +30,7 @@ pub struct CollisionEvent<V> {
 pub struct StepEvents<V> {
     /// Default collisions, in the order they were resolved.
     pub collisions: Vec<CollisionEvent<V>>,
-    /// Critters that died.
+    /// Critters that died (removed at the end of the step).
     pub deaths: Vec<CritterId>,
     /// Critters spawned.
     pub spawns: Vec<CritterId>,
@@ -123,7 +123,6 @@ impl<V: Vector> Access<'_, V> {
             if c.alive {
                 c.alive = false;
                 self.pending.deaths.push(id);
-                self.events.deaths.push(id);
             }
         }
     }
@@ -161,7 +160,9 @@ impl<V: Vector> Access<'_, V> {
     /// True when `a` and `b` touch now.
     pub fn touches_pair(&self, a: CritterId, b: CritterId) -> bool {
         match (self.critters.get(a), self.critters.get(b)) {
-            (Some(a), Some(b)) if a.id != b.id => response::contact_between(self.topo, a, b).is_some(),
+            (Some(a), Some(b)) if a.id != b.id => {
+                response::contact_between(self.topo, a, b).is_some()
+            }
             _ => false,
         }
     }
@@ -169,7 +170,11 @@ impl<V: Vector> Access<'_, V> {
     pub fn contains_pair(&self, outer: CritterId, inner: CritterId) -> bool {
         match (self.critters.get(outer), self.critters.get(inner)) {
             (Some(o), Some(i)) if o.id != i.id && !o.is_wall() && !i.is_wall() => {
-                crate::contact::contains_ball_ball(self.topo.delta(o.pos, i.pos), o.radius, i.radius)
+                crate::contact::contains_ball_ball(
+                    self.topo.delta(o.pos, i.pos),
+                    o.radius,
+                    i.radius,
+                )
             }
             _ => false,
         }
@@ -177,7 +182,8 @@ impl<V: Vector> Access<'_, V> {
     /// The engine's physical response between `caller` and `arg` (Pop's `cCritter::collide`),
     /// recorded as a collision event. `None` when they don't touch (or either is gone).
     pub fn collide_default_pair(&mut self, caller: CritterId, arg: CritterId) -> Option<Hit<V>> {
-        if caller == arg || self.critters.get(caller).is_none() || self.critters.get(arg).is_none() {
+        if caller == arg || self.critters.get(caller).is_none() || self.critters.get(arg).is_none()
+        {
             return None;
         }
         let topo = self.topo;

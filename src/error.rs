@@ -78,7 +78,7 @@ pub enum Error {
     },
     /// A script failed to compile, load or run.
     #[error("{0}")]
-    Script(ScriptError),
+    Script(Box<ScriptError>),
     /// A kind's hook failed.
     #[error("step {step}: kind '{kind}', critter {critter}: {message}")]
     Hook {
@@ -163,5 +163,11 @@ impl std::fmt::Display for ScriptError {
             write!(f, "\n  hint: {hint}")?;
         }
         Ok(())
+    }
+}
+
+impl From<ScriptError> for Error {
+    fn from(e: ScriptError) -> Self {
+        Error::Script(Box::new(e))
     }
 }

@@ -51,7 +51,9 @@ pub use critter::{
 pub use critter_set::CritterSet;
 pub use error::{Error, ScriptError};
 pub use glam;
-pub use kind::{default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx};
+pub use kind::{
+    default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx,
+};
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;

@@ -41,7 +41,7 @@ pub fn contact_between<V: Vector>(
         (Shape::Disk, Shape::Wall(w)) => contact_wall_ball(w, -d, a.radius).map(|c| Contact {
             normal: -c.normal,
             depth: c.depth,
-            point: c.point - d,
+            point: c.point + d,
         }),
         (Shape::Wall(_), Shape::Wall(_)) => None,
     }

@@ -8,8 +8,8 @@
 //! [`KindHooks::collides_with`]: crate::kind::KindHooks::collides_with
 //! [`KindHooks::rule_depends_on_state`]: crate::kind::KindHooks::rule_depends_on_state
 
-use crate::critter::{Critter, CLASS_UNSET};
 use crate::border::Topology;
+use crate::critter::{Critter, CLASS_UNSET};
 use crate::error::Error;
 use crate::kind::{CollideRule, KindId, KindSet, RuleCtx};
 use crate::vector::Vector;
@@ -73,16 +73,25 @@ pub fn roles_of<V: Vector>(
     b: &Critter<V>,
 ) -> Result<PairRule, Error> {
     let ask = |me: &Critter<V>, other: &Critter<V>| {
-        let ctx = RuleCtx { me, other, kinds, topo };
-        kinds.get(me.kind()).hooks.collides_with(&ctx).map_err(|e| match e {
-            Error::Hook { .. } | Error::Script(_) => e,
-            other_err => Error::Hook {
-                kind: kinds.name(me.kind()).to_string(),
-                critter: me.id(),
-                step: 0,
-                message: other_err.to_string(),
-            },
-        })
+        let ctx = RuleCtx {
+            me,
+            other,
+            kinds,
+            topo,
+        };
+        kinds
+            .get(me.kind())
+            .hooks
+            .collides_with(&ctx)
+            .map_err(|e| match e {
+                Error::Hook { .. } | Error::Script(_) => e,
+                other_err => Error::Hook {
+                    kind: kinds.name(me.kind()).to_string(),
+                    critter: me.id(),
+                    step: 0,
+                    message: other_err.to_string(),
+                },
+            })
     };
     let a_says = ask(a, b)?;
     let b_says = ask(b, a)?;

@@ -6,7 +6,7 @@
 
 use glam::{DMat3, DVec2, DVec3};
 use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
 /// A position or velocity in 2D or 3D, f64 throughout.
 pub trait Vector:
@@ -20,6 +20,7 @@ pub trait Vector:
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
     + Neg<Output = Self>
     + AddAssign
     + SubAssign

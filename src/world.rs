@@ -213,6 +213,8 @@ pub struct World<V: Vector> {
     /// (caller, arg, roles still to ask the hooks for)
     ruled: Vec<(u32, u32, bool)>,
     contacts: Vec<(u32, u32)>,
+    /// Candidate pairs with a wall: (first, second, roles still to ask the hooks for).
+    wall_pairs: Vec<(u32, u32, bool)>,
 }
 
 impl<V: Vector> World<V> {
@@ -243,6 +245,7 @@ impl<V: Vector> World<V> {
             candidates: Vec::new(),
             ruled: Vec::new(),
             contacts: Vec::new(),
+            wall_pairs: Vec::new(),
         })
     }
 
@@ -711,6 +714,7 @@ impl<V: Vector> World<V> {
 
     fn stage_broad_phase(&mut self) {
         self.objs.clear();
+        let mut largest_radius: f64 = 0.0;
         for c in self.critters.iter_mut() {
             if !c.alive {
                 continue;
@@ -719,7 +723,10 @@ impl<V: Vector> World<V> {
                 c.class = self.rules.class_of(&self.kinds, c);
             }
             let (half, is_wall) = match &c.shape {
-                Shape::Disk => (V::splat(c.radius), false),
+                Shape::Disk => {
+                    largest_radius = largest_radius.max(c.radius);
+                    (V::splat(c.radius), false)
+                }
                 Shape::Wall(w) => (w.aabb_half(), true),
             };
             self.objs.push(BroadObject {
@@ -728,6 +735,13 @@ impl<V: Vector> World<V> {
                 slot: c.id.index,
                 is_wall,
             });
+        }
+        // Wall pairs are tested after the disk pairs have been separated (see the response), and
+        // a separation moves a disk by at most about its radius: widen walls' boxes by that much.
+        if !self.walls.is_empty() {
+            for o in self.objs.iter_mut().filter(|o| o.is_wall) {
+                o.half += V::splat(largest_radius);
+            }
         }
         self.broad
             .find_pairs(&self.objs, &self.topo, &mut self.candidates);
@@ -739,7 +753,11 @@ impl<V: Vector> World<V> {
             let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
                 continue;
             };
-            match self.rules.rule(&self.kinds, &self.topo, ca, cb).map_err(|e| at_step(e, self.step_count))? {
+            match self
+                .rules
+                .rule(&self.kinds, &self.topo, ca, cb)
+                .map_err(|e| at_step(e, self.step_count))?
+            {
                 Some(rule) => {
                     if let Some((caller, arg)) = roles_order(rule, ca, cb) {
                         self.ruled.push((caller.id.index, arg.id.index, false));
@@ -754,22 +772,23 @@ impl<V: Vector> World<V> {
 
     fn stage_narrow_phase(&mut self) -> Result<(), Error> {
         self.contacts.clear();
+        self.wall_pairs.clear();
         let topo = &self.topo;
         for &(first, second, ask) in &self.ruled {
             let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
                 continue;
             };
-            let touching = match (&a.shape, &b.shape) {
-                (Shape::Disk, Shape::Disk) => {
-                    crate::contact::touching_ball_ball(topo.delta(a.pos, b.pos), a.radius, b.radius)
-                }
-                _ => crate::response::contact_between(topo, a, b).is_some(),
-            };
-            if !touching {
+            if a.is_wall() || b.is_wall() {
+                // Tested in the response, once the disk pairs have moved.
+                self.wall_pairs.push((first, second, ask));
+                continue;
+            }
+            if !crate::contact::touching_ball_ball(topo.delta(a.pos, b.pos), a.radius, b.radius) {
                 continue;
             }
             if ask {
-                let rule = crate::rules::roles_of(&self.kinds, topo, a, b).map_err(|e| at_step(e, self.step_count))?;
+                let rule = crate::rules::roles_of(&self.kinds, topo, a, b)
+                    .map_err(|e| at_step(e, self.step_count))?;
                 if let Some((caller, arg)) = roles_order(rule, a, b) {
                     self.contacts.push((caller.id.index, arg.id.index));
                 }
@@ -777,50 +796,93 @@ impl<V: Vector> World<V> {
                 self.contacts.push((first, second));
             }
         }
-        // Disk pairs by id, then pairs with a wall, so walls have the last word on positions.
-        let critters = &self.critters;
-        let has_wall = |s: u32| critters.slot(s).is_some_and(Critter::is_wall);
-        self.contacts.sort_unstable_by_key(|&(c, a)| {
-            let wall = has_wall(c) || has_wall(a);
-            (wall, c.min(a), c.max(a))
-        });
+        self.contacts
+            .sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
+        self.wall_pairs
+            .sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
         Ok(())
     }
 
+    /// Disk pairs first, in id order; then pairs with a wall, tested where the disks are now, so
+    /// no separation pushes a critter back into a wall.
     fn stage_response(&mut self) -> Result<usize, Error> {
         let mut collisions = 0;
-        let step = self.step_count;
-        let contacts = std::mem::take(&mut self.contacts);
+        let disk_contacts = std::mem::take(&mut self.contacts);
+        for &(caller, arg) in &disk_contacts {
+            if self.collide_pair(caller, arg)? {
+                collisions += 1;
+            }
+        }
+        self.contacts = disk_contacts;
+        let wall_pairs = std::mem::take(&mut self.wall_pairs);
         let mut result = Ok(());
-        for &(caller, arg) in &contacts {
-            let (Some(c), Some(a)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
+        for &(first, second, ask) in &wall_pairs {
+            let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
                 continue;
             };
-            if !c.alive || !a.alive {
+            if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none()
+            {
                 continue;
             }
-            let (kind, id) = (c.kind, c.id);
-            let hooks = self.kinds.get(kind).hooks.clone();
-            let mut ctx = CollideCtx {
-                access: self.access(),
-                me: caller,
-                other: arg,
+            let (caller, arg) = if ask {
+                match crate::rules::roles_of(&self.kinds, &self.topo, a, b) {
+                    Ok(rule) => match roles_order(rule, a, b) {
+                        Some((c, x)) => (c.id.index, x.id.index),
+                        None => continue,
+                    },
+                    Err(e) => {
+                        result = Err(at_step(e, self.step_count));
+                        break;
+                    }
+                }
+            } else {
+                (first, second)
             };
-            match hooks.collide(&mut ctx) {
+            self.contacts.push((caller, arg));
+            match self.collide_pair(caller, arg) {
                 Ok(true) => collisions += 1,
                 Ok(false) => {}
                 Err(e) => {
-                    result = Err(hook_error(e, &self.kinds, kind, id, step));
+                    result = Err(e);
                     break;
                 }
             }
         }
-        self.contacts = contacts;
-        result.map(|()| collisions)
+        self.wall_pairs = wall_pairs;
+        result?;
+        if self.topo.wraps() {
+            // Separation may have pushed a critter across the periodic edge.
+            let topo = self.topo;
+            for c in self.critters.iter_mut().filter(|c| c.alive && !c.is_wall()) {
+                c.pos = topo.wrap_position(c.pos);
+            }
+        }
+        Ok(collisions)
+    }
+
+    /// Calls the caller's `collide` on a touching pair, if both are still alive.
+    fn collide_pair(&mut self, caller: u32, arg: u32) -> Result<bool, Error> {
+        let (Some(c), Some(a)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
+            return Ok(false);
+        };
+        if !c.alive || !a.alive {
+            return Ok(false);
+        }
+        let (kind, id, step) = (c.kind, c.id, self.step_count);
+        let hooks = self.kinds.get(kind).hooks.clone();
+        let mut ctx = CollideCtx {
+            access: self.access(),
+            me: caller,
+            other: arg,
+        };
+        hooks
+            .collide(&mut ctx)
+            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
     }
 
     fn stage_lifecycle(&mut self) -> Result<(), Error> {
         for id in std::mem::take(&mut self.pending.deaths) {
+            self.events.deaths.push(id);
             if let Some(c) = self.critters.remove(id) {
                 if c.is_wall() {
                     self.walls.retain(|&w| w != id);
@@ -838,7 +900,12 @@ impl<V: Vector> World<V> {
 /// Sets the step of a hook error raised where the step was not known.
 fn at_step(e: Error, step: u64) -> Error {
     match e {
-        Error::Hook { kind, critter, message, .. } => Error::Hook {
+        Error::Hook {
+            kind,
+            critter,
+            message,
+            ..
+        } => Error::Hook {
             kind,
             critter,
             step,
