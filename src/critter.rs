@@ -76,6 +76,8 @@ pub enum PropValue {
     Critter(CritterId),
     /// A list of values.
     List(Vec<PropValue>),
+    /// A vector (z = 0 in 2D).
+    Vector([f64; 3]),
 }
 
 /// A critter's user properties, ordered by name so iteration is deterministic.

@@ -36,6 +36,7 @@ pub mod response;
 pub mod rng;
 pub mod rules;
 pub mod scenes;
+pub mod script;
 
 pub mod vector;
 pub mod wall;

@@ -84,7 +84,11 @@ pub fn roles_of<V: Vector>(
             .hooks
             .collides_with(&ctx)
             .map_err(|e| match e {
-                Error::Hook { .. } | Error::Script(_) => e,
+                Error::Script(mut s) => {
+                    s.critter.get_or_insert(me.id());
+                    Error::Script(s)
+                }
+                Error::Hook { .. } => e,
                 other_err => Error::Hook {
                     kind: kinds.name(me.kind()).to_string(),
                     critter: me.id(),

@@ -89,6 +89,69 @@ impl AnyWorld {
     pub fn border(&self) -> Border {
         both!(self, w => w.topology().border)
     }
+    /// Changes the time step.
+    pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
+        both!(self, w => w.set_dt(dt))
+    }
+    /// Log lines of the last step.
+    pub fn log(&self) -> &[String] {
+        both!(self, w => &w.events().log)
+    }
+}
+
+/// A script file that a run used, kept so a recording can hold everything needed to rerun it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SourceFile {
+    /// The path it was loaded from.
+    pub path: String,
+    /// Its text as loaded (after `--set` overrides).
+    pub text: String,
+}
+
+/// A scene's own step-by-step logic: runs after each step; `Some(reason)` asks the run to stop.
+pub type OnStep = Box<dyn FnMut(&mut AnyWorld) -> Result<Option<String>, Error>>;
+
+/// A world ready to run, with what the scene adds around it.
+pub struct Scene {
+    /// Name (a built-in scene's name, or a script's file stem).
+    pub name: String,
+    /// The world.
+    pub world: AnyWorld,
+    /// Steps to run when none are asked for.
+    pub default_steps: u64,
+    /// The scene's `on_step`, if it has one.
+    pub on_step: Option<OnStep>,
+    /// Script files used (empty for built-in scenes).
+    pub sources: Vec<SourceFile>,
+}
+
+impl Scene {
+    /// A scene of `world` with no script around it.
+    pub fn new(name: impl Into<String>, world: AnyWorld, default_steps: u64) -> Self {
+        Scene {
+            name: name.into(),
+            world,
+            default_steps,
+            on_step: None,
+            sources: Vec::new(),
+        }
+    }
+
+    /// One step of the world, then the scene's `on_step`. Returns the reason when the scene asks
+    /// to stop.
+    pub fn step(&mut self) -> Result<Option<String>, Error> {
+        self.world.step()?;
+        match &mut self.on_step {
+            Some(f) => f(&mut self.world),
+            None => Ok(None),
+        }
+    }
+}
+
+/// Builds the built-in scene `name` as a [`Scene`].
+pub fn builtin(name: &str, params: &SceneParams) -> Result<Scene, Error> {
+    let info = find(name)?;
+    Ok(Scene::new(name, (info.build)(params)?, info.default_steps))
 }
 
 /// What a scene can be asked to vary.

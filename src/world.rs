@@ -965,6 +965,11 @@ fn hash_prop(h: &mut StateHasher, value: &PropValue) {
         PropValue::Float(x) => h.float(*x),
         PropValue::Text(s) => hash_bytes(h, s.as_bytes()),
         PropValue::Critter(id) => h.word(((id.index as u64) << 32) | id.generation as u64),
+        PropValue::Vector(v) => {
+            for x in v {
+                h.float(*x);
+            }
+        }
         PropValue::List(items) => {
             h.word(items.len() as u64);
             for item in items {

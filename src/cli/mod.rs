@@ -2,6 +2,7 @@
 //!
 //! `src/main.rs` parses, calls [`execute`], and turns the outcome into an exit code.
 
+pub mod check;
 pub mod run;
 
 use clap::{Parser, Subcommand};
@@ -20,12 +21,15 @@ pub struct Cli {
 pub enum Command {
     /// Run a scene headless and print a summary.
     Run(run::RunArgs),
+    /// Compile and check scene and kind scripts without running them (for editors and CI).
+    Check(check::CheckArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
 pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Run(args)) => run::run(&args, out),
+        Some(Command::Check(args)) => check::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }

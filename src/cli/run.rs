@@ -1,6 +1,7 @@
 //! `critterbox run`: run a scene headless and print a summary.
 
-use crate::scenes::{self, AnyWorld, SceneParams, DEFAULT_SCENE, SCENES};
+use crate::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
+use crate::script::{Limits, ScriptOptions};
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -10,8 +11,17 @@ use std::time::{Duration, Instant};
 /// Arguments of `critterbox run`.
 #[derive(Args, Debug, Default)]
 pub struct RunArgs {
-    /// Built-in scene to run (see --list). Default: gas.
+    /// A scene script (scripts/scenes/NAME.rhai) or a built-in scene (see --list). Default: gas.
     pub scene: Option<String>,
+    /// Override a scene script's constant: --set SPEED=20 (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub sets: Vec<String>,
+    /// Most operations one script call may run before it is stopped (endless-loop guard).
+    #[arg(long, default_value_t = Limits::default().max_operations)]
+    pub max_ops: u64,
+    /// Most spawns scripts may request in one step.
+    #[arg(long, default_value_t = Limits::default().max_spawns_per_step)]
+    pub max_spawns: u64,
     /// List the built-in scenes and exit.
     #[arg(long)]
     pub list: bool,
@@ -21,9 +31,10 @@ pub struct RunArgs {
     /// Time step in seconds (default: the scene's own).
     #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
-    /// Seed of the world's random generator: the same seed gives a bit-identical run.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    /// Seed of the world's random generator (default: the scene's own, 1 for built-ins): the
+    /// same seed gives a bit-identical run.
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Number of critters, for scenes that have a natural count (gas, cradle, pegs).
     #[arg(short = 'n', long)]
     pub n: Option<usize>,
@@ -46,42 +57,97 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         }
         return Ok(());
     }
-    let name = args.scene.as_deref().unwrap_or(DEFAULT_SCENE);
-    let info = scenes::find(name)?;
     if let Some(dt) = args.dt {
         anyhow::ensure!(
             dt.is_finite() && dt > 0.0,
             "--dt {dt}: the time step must be a finite number greater than zero"
         );
     }
-    let params = SceneParams {
-        n: args.n,
-        seed: args.seed,
-        dt: args.dt,
-    };
-    let mut world =
-        scenes::build(name, &params).with_context(|| format!("building scene '{name}'"))?;
-    let steps = args.steps.unwrap_or(info.default_steps);
+    let mut scene = load(args)?;
+    if let Some(dt) = args.dt {
+        scene.world.set_dt(dt)?;
+    }
+    let name = scene.name.clone();
+    let steps = args.steps.unwrap_or(scene.default_steps);
 
-    let energy0 = world.kinetic_energy();
-    let momentum0 = world.momentum();
+    let energy0 = scene.world.kinetic_energy();
+    let momentum0 = scene.world.momentum();
     let bar = progress_bar(steps);
     let started = Instant::now();
+    let mut stopped = None;
     for i in 0..steps {
-        world
-            .step()
-            .with_context(|| format!("scene '{name}', step {}", world.step_count()))?;
+        let step = scene.world.step_count();
+        let outcome = scene.step();
+        let log = scene.world.log();
+        if !log.is_empty() {
+            bar.suspend(|| {
+                for line in log {
+                    eprintln!("[step {step}] {line}");
+                }
+            });
+        }
+        if let Some(reason) = outcome.with_context(|| format!("scene '{name}', step {step}"))? {
+            stopped = Some((scene.world.step_count(), reason));
+            break;
+        }
         if i % 16 == 15 {
             bar.set_position(i + 1);
         }
     }
     let wall = started.elapsed();
     bar.finish_and_clear();
-    summary(out, name, &world, steps, energy0, momentum0, wall)?;
+    let done = scene.world.step_count();
+    summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
+    if let Some((at, reason)) = stopped {
+        writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
+    }
     if args.stats {
-        stats(out, &world, steps)?;
+        stats(out, &scene.world, done)?;
     }
     Ok(())
+}
+
+/// A scene script when SCENE names a file, a built-in scene otherwise.
+fn load(args: &RunArgs) -> anyhow::Result<Scene> {
+    let name = args.scene.as_deref().unwrap_or(DEFAULT_SCENE);
+    let is_script = name.ends_with(".rhai") || std::path::Path::new(name).is_file();
+    if !is_script {
+        anyhow::ensure!(
+            args.sets.is_empty(),
+            "--set works on scene scripts; '{name}' is a built-in scene (try -n, --dt, --seed)"
+        );
+        let params = SceneParams {
+            n: args.n,
+            seed: args.seed.unwrap_or(1),
+            dt: args.dt,
+        };
+        return Ok(scenes::builtin(name, &params)?);
+    }
+    anyhow::ensure!(
+        args.n.is_none(),
+        "-n works on built-in scenes; a scene script sets its own counts (use --set NAME=VALUE)"
+    );
+    let mut sets = Vec::new();
+    for s in &args.sets {
+        let (k, v) = s
+            .split_once('=')
+            .with_context(|| format!("--set {s}: write NAME=VALUE, e.g. --set SPEED=20"))?;
+        sets.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    let options = ScriptOptions {
+        limits: Limits {
+            max_operations: args.max_ops,
+            max_spawns_per_step: args.max_spawns,
+            ..Limits::default()
+        },
+        seed: args.seed,
+        ..ScriptOptions::default()
+    };
+    Ok(crate::script::load_scene(
+        std::path::Path::new(name),
+        &sets,
+        &options,
+    )?)
 }
 
 fn progress_bar(steps: u64) -> ProgressBar {

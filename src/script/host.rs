@@ -1,0 +1,321 @@
+//! The bridge between running scripts and the world they act on.
+//!
+//! A script function registered with the engine cannot hold a borrow of the world: the world
+//! calls the script (from a hook, inside `World::step`), and the script calls back into the world.
+//! So while a script runs, the [`Host`] holds a raw pointer to what the script may touch: the
+//! whole [`World`] (scene setup, `on_step`) or a hook's [`Access`] (inside a step). The pointer is
+//! set by [`Host::enter`] for exactly the duration of one call into the script and restored by a
+//! guard, so it never outlives the borrow it came from; script functions reach it through
+//! [`with_env!`], one short-lived `&mut` at a time.
+
+use crate::border::Topology;
+use crate::context::Access;
+use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::error::Error;
+use crate::kind::{KindId, KindSet};
+use crate::rng::Rng;
+use crate::vector::Vector;
+use crate::world::World;
+use glam::{DVec2, DVec3};
+use std::cell::{Cell, RefCell};
+
+/// What a script may do to the world it runs in.
+pub(crate) trait Env<V: Vector> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>>;
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>>;
+    fn kinds(&self) -> &KindSet<V>;
+    #[allow(dead_code)] // part of the contract; scripts reach the box through `world()` later
+    fn topology(&self) -> &Topology<V>;
+    fn step_count(&self) -> u64;
+    fn time(&self) -> f64;
+    fn dt(&self) -> f64;
+    fn rng(&mut self) -> &mut Rng;
+    fn die(&mut self, id: CritterId);
+    fn damage(&mut self, id: CritterId, amount: f64);
+    /// Spawns now (`Some(id)`) between steps, or queues for the end of the step (`None`).
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error>;
+    fn log(&mut self, line: String);
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
+    fn touches(&self, a: CritterId, b: CritterId) -> bool;
+    fn contains(&self, outer: CritterId, inner: CritterId) -> bool;
+    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64>;
+    /// The default response; `Err` outside a step.
+    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
+    /// The world itself, between steps (scene setup and `on_step`).
+    fn world(&mut self) -> Option<&mut World<V>>;
+}
+
+impl<V: Vector> Env<V> for World<V> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.get(id)
+    }
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.get_mut(id)
+    }
+    fn kinds(&self) -> &KindSet<V> {
+        World::kinds(self)
+    }
+    fn topology(&self) -> &Topology<V> {
+        World::topology(self)
+    }
+    fn step_count(&self) -> u64 {
+        World::step_count(self)
+    }
+    fn time(&self) -> f64 {
+        World::time(self)
+    }
+    fn dt(&self) -> f64 {
+        World::dt(self)
+    }
+    fn rng(&mut self) -> &mut Rng {
+        World::rng(self)
+    }
+    fn die(&mut self, id: CritterId) {
+        // Between steps a death takes effect at once.
+        let _ = self.remove(id);
+    }
+    fn damage(&mut self, id: CritterId, amount: f64) {
+        let dead = match self.get_mut(id) {
+            Some(c) => {
+                c.health -= amount;
+                c.health <= 0.0
+            }
+            None => false,
+        };
+        if dead {
+            let _ = self.remove(id);
+        }
+    }
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
+        World::spawn(self, spec).map(Some)
+    }
+    fn log(&mut self, line: String) {
+        self.log_line(line);
+    }
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
+        self.critters()
+            .iter()
+            .filter(|c| c.is_alive() && World::kinds(self).is_kind(c.kind(), kind))
+            .map(|c| c.id())
+            .collect()
+    }
+    fn touches(&self, a: CritterId, b: CritterId) -> bool {
+        match (self.get(a), self.get(b)) {
+            (Some(x), Some(y)) if a != b => {
+                crate::response::contact_between(World::topology(self), x, y).is_some()
+            }
+            _ => false,
+        }
+    }
+    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
+        match (self.get(outer), self.get(inner)) {
+            (Some(o), Some(i)) if outer != inner && !o.is_wall() && !i.is_wall() => {
+                let d = World::topology(self).delta(o.pos, i.pos);
+                crate::contact::contains_ball_ball(d, o.radius(), i.radius())
+            }
+            _ => false,
+        }
+    }
+    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
+        let (x, y) = (self.get(a)?, self.get(b)?);
+        Some(World::topology(self).delta(x.pos, y.pos).length())
+    }
+    fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
+        Err("collide_default can only be called inside a collide hook".into())
+    }
+    fn world(&mut self) -> Option<&mut World<V>> {
+        Some(self)
+    }
+}
+
+impl<V: Vector> Env<V> for Access<'_, V> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.get(id)
+    }
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.get_mut(id)
+    }
+    fn kinds(&self) -> &KindSet<V> {
+        Access::kinds(self)
+    }
+    fn topology(&self) -> &Topology<V> {
+        Access::topology(self)
+    }
+    fn step_count(&self) -> u64 {
+        self.step()
+    }
+    fn time(&self) -> f64 {
+        Access::time(self)
+    }
+    fn dt(&self) -> f64 {
+        Access::dt(self)
+    }
+    fn rng(&mut self) -> &mut Rng {
+        Access::rng(self)
+    }
+    fn die(&mut self, id: CritterId) {
+        Access::die(self, id)
+    }
+    fn damage(&mut self, id: CritterId, amount: f64) {
+        Access::damage(self, id, amount)
+    }
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
+        Access::spawn(self, spec);
+        Ok(None)
+    }
+    fn log(&mut self, line: String) {
+        Access::log(self, line)
+    }
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
+        Access::critters_of(self, kind)
+    }
+    fn touches(&self, a: CritterId, b: CritterId) -> bool {
+        self.touches_pair(a, b)
+    }
+    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
+        self.contains_pair(outer, inner)
+    }
+    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
+        self.distance_pair(a, b)
+    }
+    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String> {
+        Ok(self.collide_default_pair(caller, arg).is_some())
+    }
+    fn world(&mut self) -> Option<&mut World<V>> {
+        None
+    }
+}
+
+/// The current environment of a running script, if any.
+#[derive(Clone, Copy)]
+pub(crate) enum EnvPtr {
+    None,
+    D2(*mut (dyn Env<DVec2> + 'static)),
+    D3(*mut (dyn Env<DVec3> + 'static)),
+}
+
+/// A dimension scripts can run in.
+pub(crate) trait Dim: Vector {
+    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr;
+}
+
+impl Dim for DVec2 {
+    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr {
+        EnvPtr::D2(env)
+    }
+}
+
+impl Dim for DVec3 {
+    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr {
+        EnvPtr::D3(env)
+    }
+}
+
+/// Shared state of one script runtime: where running scripts act, and per-step counters.
+pub(crate) struct Host {
+    env: Cell<EnvPtr>,
+    /// Spawns requested by scripts in the current step.
+    pub spawns: Cell<u64>,
+    /// The step `spawns` counts for.
+    pub spawns_step: Cell<u64>,
+    /// Most spawns scripts may request in one step.
+    pub max_spawns_per_step: u64,
+    /// The runtime this host belongs to (for loading kinds from scripts).
+    pub runtime: super::RuntimeLink,
+    /// While a kind file's top level runs: what it declares.
+    pub kind_decl: RefCell<Option<super::kind::KindDecl>>,
+    /// The world a scene script is building (owned here while the scene's top level runs).
+    pub scene_world: Cell<*mut crate::scenes::AnyWorld>,
+    /// Set by `world.stop(reason)`.
+    pub stop: RefCell<Option<String>>,
+    /// Steps the scene asked for (`world(#{ steps: ... })`).
+    pub scene_steps: Cell<Option<u64>>,
+    /// `--seed`, which wins over the scene's own seed.
+    pub seed_override: Cell<Option<u64>>,
+}
+
+impl Host {
+    pub fn new(max_spawns_per_step: u64) -> Self {
+        Host {
+            env: Cell::new(EnvPtr::None),
+            spawns: Cell::new(0),
+            spawns_step: Cell::new(u64::MAX),
+            max_spawns_per_step,
+            runtime: RefCell::new(std::rc::Weak::new()),
+            kind_decl: RefCell::new(None),
+            scene_world: Cell::new(std::ptr::null_mut()),
+            stop: RefCell::new(None),
+            scene_steps: Cell::new(None),
+            seed_override: Cell::new(None),
+        }
+    }
+
+    /// Runs `f` with no world reachable from scripts (kind files' top level).
+    pub fn without_env<R>(&self, f: impl FnOnce() -> R) -> R {
+        struct Restore<'h>(&'h Cell<EnvPtr>, EnvPtr);
+        impl Drop for Restore<'_> {
+            fn drop(&mut self) {
+                self.0.set(self.1);
+            }
+        }
+        let _restore = Restore(&self.env, self.env.replace(EnvPtr::None));
+        f()
+    }
+
+    /// Points scripts at `ptr` until [`Host::clear_env`] (a scene's top level, which spans many
+    /// calls). The caller keeps the pointee alive and otherwise untouched until then.
+    pub fn set_env(&self, ptr: EnvPtr) {
+        self.env.set(ptr);
+    }
+
+    /// Ends [`Host::set_env`].
+    pub fn clear_env(&self) {
+        self.env.set(EnvPtr::None);
+    }
+
+    /// Runs `f` with scripts acting on `env`; the previous environment is restored afterwards,
+    /// also when `f` unwinds.
+    pub fn enter<V: Dim, R>(&self, env: &mut dyn Env<V>, f: impl FnOnce() -> R) -> R {
+        struct Restore<'h>(&'h Cell<EnvPtr>, EnvPtr);
+        impl Drop for Restore<'_> {
+            fn drop(&mut self) {
+                self.0.set(self.1);
+            }
+        }
+        let short: *mut (dyn Env<V> + '_) = env;
+        // SAFETY: only the lifetime bound is erased. The pointer is stored for the duration of
+        // `f` and removed by `Restore` before `env`'s borrow ends; it is dereferenced only inside
+        // `f` (by script functions called from it), never concurrently with another use of `env`.
+        let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
+        let _restore = Restore(&self.env, self.env.replace(V::env_ptr(erased)));
+        f()
+    }
+
+    /// The current environment.
+    pub fn current(&self) -> EnvPtr {
+        self.env.get()
+    }
+}
+
+/// Runs `$body` with `$env` bound to the current environment as `&mut dyn Env<V>`, for whichever
+/// dimension the running world has. Evaluates to an error when no world is active.
+macro_rules! with_env {
+    ($host:expr, $env:ident => $body:expr) => {
+        match $host.current() {
+            $crate::script::host::EnvPtr::None => Err($crate::script::api::no_world()),
+            $crate::script::host::EnvPtr::D2(p) => {
+                // SAFETY: see `Host::enter`: the pointer is live while a script runs.
+                #[allow(unused_unsafe)]
+                let $env = unsafe { &mut *p };
+                $body
+            }
+            $crate::script::host::EnvPtr::D3(p) => {
+                // SAFETY: as above.
+                #[allow(unused_unsafe)]
+                let $env = unsafe { &mut *p };
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_env;

@@ -1,0 +1,180 @@
+//! rhai scripts: scenes (`scripts/scenes/*.rhai`) that set up a world, and kinds
+//! (`scripts/kinds/*.rhai`) that give critters their own `collide`, `collides_with`, `update` and
+//! `init`. The user's guide is `docs/scripting.md`.
+//!
+//! One [`Runtime`] per run holds the engine (built once by [`api::build_engine`]), each kind's
+//! compiled AST, and the [`host::Host`] through which running scripts reach the world. Each hook is
+//! a plain `call_fn` on an AST compiled once, with the top level not re-run and no per-call scope
+//! allocation; a kind's hooks run only for pairs that really touch, and only for kinds that
+//! define them.
+
+pub(crate) mod api;
+pub(crate) mod errors;
+pub(crate) mod host;
+pub(crate) mod kind;
+pub(crate) mod scene;
+
+use crate::error::{Error, ScriptError};
+use crate::scenes::Scene;
+use host::Host;
+use rhai::{Engine, AST};
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::rc::{Rc, Weak};
+
+/// Limits on what one script call may do. The defaults are far above what real scripts need.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limits {
+    /// Operations per hook call (an endless loop stops here).
+    pub max_operations: u64,
+    /// Depth of nested function calls.
+    pub max_call_levels: usize,
+    /// Longest string.
+    pub max_string_size: usize,
+    /// Longest array.
+    pub max_array_size: usize,
+    /// Largest map.
+    pub max_map_size: usize,
+    /// Spawns scripts may request in one step.
+    pub max_spawns_per_step: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_operations: 1_000_000,
+            max_call_levels: 64,
+            max_string_size: 1 << 20,
+            max_array_size: 1 << 20,
+            max_map_size: 1 << 16,
+            max_spawns_per_step: 100_000,
+        }
+    }
+}
+
+pub use crate::scenes::SourceFile;
+
+/// Where scripts live and how they are limited.
+#[derive(Clone, Debug, Default)]
+pub struct ScriptOptions {
+    /// Limits per call and per step.
+    pub limits: Limits,
+    /// Extra folders to look for kinds in (before the defaults).
+    pub kind_dirs: Vec<PathBuf>,
+    /// A seed that overrides the scene's own.
+    pub seed: Option<u64>,
+}
+
+/// The engine, the kinds loaded so far, and the bridge to the world.
+pub(crate) struct Runtime {
+    pub engine: Engine,
+    pub host: Rc<Host>,
+    /// Folders searched for `name.rhai` when a kind is asked for by name.
+    pub kind_dirs: Vec<PathBuf>,
+    /// Script kinds by name.
+    pub kinds: RefCell<BTreeMap<String, Rc<kind::ScriptKindDef>>>,
+    /// Every file loaded, in load order.
+    pub sources: RefCell<Vec<SourceFile>>,
+}
+
+impl Runtime {
+    pub fn new(options: &ScriptOptions, scene_dir: Option<&Path>) -> Rc<Runtime> {
+        let host = Rc::new(Host::new(options.limits.max_spawns_per_step));
+        host.seed_override.set(options.seed);
+        let engine = api::build_engine(&host, &options.limits);
+        let mut kind_dirs = options.kind_dirs.clone();
+        if let Some(dir) = scene_dir {
+            kind_dirs.push(dir.join("../kinds"));
+            kind_dirs.push(dir.join("kinds"));
+            kind_dirs.push(dir.to_path_buf());
+        }
+        kind_dirs.push(PathBuf::from("scripts/kinds"));
+        let rt = Rc::new(Runtime {
+            engine,
+            host,
+            kind_dirs,
+            kinds: RefCell::new(BTreeMap::new()),
+            sources: RefCell::new(Vec::new()),
+        });
+        *rt.host.runtime.borrow_mut() = Rc::downgrade(&rt);
+        rt
+    }
+
+    /// Compiles `text` as `path`; errors carry file, line and column.
+    pub fn compile(&self, path: &str, text: &str) -> Result<AST, Error> {
+        let mut ast = self
+            .engine
+            .compile(text)
+            .map_err(|e| Error::from(errors::parse_error(path, &e)))?;
+        ast.set_source(path);
+        Ok(ast)
+    }
+}
+
+/// Reads a script file; a missing or unreadable file is a clear error.
+pub(crate) fn read_script(path: &Path) -> Result<String, Error> {
+    std::fs::read_to_string(path).map_err(|e| {
+        let mut err = ScriptError::new(
+            path.display().to_string(),
+            format!("cannot read the script: {e}"),
+        );
+        err.hint = Some(
+            "check the path; scene scripts live in scripts/scenes/, kinds in scripts/kinds/".into(),
+        );
+        Error::from(err)
+    })
+}
+
+/// Loads a scene script, applying `--set NAME=VALUE` overrides to its top-level constants.
+pub fn load_scene(
+    path: &Path,
+    sets: &[(String, String)],
+    options: &ScriptOptions,
+) -> Result<Scene, Error> {
+    scene::load(path, sets, options)
+}
+
+/// Compiles and checks script files without running a world: scenes are set up (not stepped),
+/// kinds are loaded and their hooks checked. Returns one line per file checked.
+pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, Error> {
+    let mut report = Vec::new();
+    for path in paths {
+        let text = read_script(path)?;
+        if scene::looks_like_scene(&text) {
+            let scene = load_scene(path, &[], options)?;
+            report.push(format!(
+                "{}: scene ok ({}D, {} critters, kinds: {})",
+                path.display(),
+                scene.world.dim(),
+                scene.world.len(),
+                scene
+                    .world
+                    .count_by_kind()
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        } else {
+            let dir = path.parent().map(Path::to_path_buf);
+            let rt = Runtime::new(options, dir.as_deref());
+            let def = kind::load_def(&rt, &path.display().to_string())?;
+            let hooks: Vec<&str> = def.hook_names().collect();
+            report.push(format!(
+                "{}: kind '{}' ok (hooks: {})",
+                path.display(),
+                def.name,
+                if hooks.is_empty() {
+                    "none".to_string()
+                } else {
+                    hooks.join(", ")
+                }
+            ));
+        }
+    }
+    Ok(report)
+}
+
+/// The weak link from the host back to its runtime.
+pub(crate) type RuntimeLink = RefCell<Weak<Runtime>>;

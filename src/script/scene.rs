@@ -1,0 +1,686 @@
+//! Scene scripts: the functions that build a world (`world(#{ ... })`, walls, spawning patterns,
+//! `load_kind`), kind declarations (`extends`, `defaults`), and loading a scene file.
+
+use super::api::{fail, from_svec, num_or, spawn_in, to_svec, CritterRef, Res, WorldRef};
+use super::errors::{eval_error, fn_location};
+use super::host::{with_env, Dim, EnvPtr, Host};
+use super::kind::{load_into, KindDecl};
+use super::{read_script, Runtime, ScriptOptions, SourceFile};
+use crate::border::Border;
+use crate::error::{Error, ScriptError};
+use crate::scenes::{AnyWorld, Scene};
+use crate::vector::Vector;
+use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
+use crate::world::{World, WorldConfig};
+use glam::{DMat3, DVec2, DVec3};
+use rhai::{Array, CallFnOptions, Dynamic, Engine, EvalAltResult, Map, Position, Scope, INT};
+use std::path::Path;
+use std::rc::Rc;
+
+/// The keys `world(#{ ... })` accepts.
+const WORLD_KEYS: &[&str] = &[
+    "dim", "size", "min", "border", "gravity", "dt", "seed", "method", "steps",
+];
+
+fn runtime(host: &Host) -> Res<Rc<Runtime>> {
+    host.runtime
+        .borrow()
+        .upgrade()
+        .map_or_else(|| fail("the script runtime is gone"), Ok)
+}
+
+fn lib_err(e: Error) -> Box<EvalAltResult> {
+    let text = match e {
+        Error::Script(s) => s.to_string(),
+        other => other.to_string(),
+    };
+    Box::new(EvalAltResult::ErrorRuntime(
+        Dynamic::from(text),
+        Position::NONE,
+    ))
+}
+
+/// Loads kind `name` into whatever world scripts act on, unless it is there already.
+fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<()> {
+    let known = with_env!(host, env => Ok(env.kinds().id(name).is_ok()))?;
+    if known {
+        return Ok(());
+    }
+    let rt = runtime(host)?;
+    with_env!(host, env => match env.world() {
+        Some(world) => load_into(&rt, world, name).map(|_| ()).map_err(lib_err),
+        None => fail(format!(
+            "unknown kind '{name}': kinds are loaded between steps; call load_kind(\"{name}\") in the scene script"
+        )),
+    })
+}
+
+fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
+    let mut size = V::splat(10.0);
+    let mut min = V::zero();
+    let mut config = WorldConfig::new(V::zero(), V::splat(10.0));
+    let mut steps = None;
+    for (key, value) in map {
+        match key.as_str() {
+            "dim" => {}
+            "size" => {
+                size = match num(value) {
+                    Some(s) => V::splat(s),
+                    None => from_svec(vec_arg(value, "size")?),
+                }
+            }
+            "min" => min = from_svec(vec_arg(value, "min")?),
+            "border" => {
+                config.border = value.to_string().parse::<Border>().map_or_else(fail, Ok)?;
+            }
+            "gravity" => config.gravity = from_svec(vec_arg(value, "gravity")?),
+            "dt" => config.dt = num_or(value, "dt")?,
+            "seed" => {
+                config.seed = value.as_int().ok().filter(|s| *s >= 0).map_or_else(
+                    || fail("seed must be a whole number >= 0"),
+                    |s| Ok(s as u64),
+                )?
+            }
+            "method" => {
+                let m = value.to_string();
+                if m != "discrete" {
+                    return fail(format!(
+                        "method '{m}' is not available yet: the engine has the discrete method only (method: \"discrete\")"
+                    ));
+                }
+            }
+            "steps" => {
+                steps = Some(value.as_int().ok().filter(|s| *s >= 0).map_or_else(
+                    || fail("steps must be a whole number >= 0"),
+                    |s| Ok(s as u64),
+                )?)
+            }
+            other => {
+                return fail(format!(
+                    "unknown world setting '{other}'; the settings are {}",
+                    WORLD_KEYS.join(", ")
+                ))
+            }
+        }
+    }
+    config.min = min;
+    config.max = min + size;
+    Ok((config, steps))
+}
+
+fn num(d: &Dynamic) -> Option<f64> {
+    super::api::num(d)
+}
+
+fn vec_arg(d: &Dynamic, what: &str) -> Res<DVec3> {
+    d.clone().try_cast::<DVec3>().map_or_else(
+        || {
+            fail(format!(
+                "{what} must be a Vec (e.g. vec(20, 10)) or a number"
+            ))
+        },
+        Ok,
+    )
+}
+
+/// `world(#{ dim: 2, size: vec(20, 10), ... })`: makes the scene's world and points scripts at it.
+fn make_world(host: &Rc<Host>, map: &Map) -> Res<WorldRef> {
+    if !host.scene_world.get().is_null() {
+        return fail("this scene already made its world; call world(#{ ... }) once");
+    }
+    if host.kind_decl.borrow().is_some() {
+        return fail("a kind file cannot make a world; world(#{ ... }) belongs in a scene script");
+    }
+    let dim = match map.get("dim") {
+        None => 2,
+        Some(d) => d
+            .as_int()
+            .map_err(|_| super::api::fail::<()>("dim must be 2 or 3").unwrap_err())?,
+    };
+    let seed = host.seed_override.get();
+    let (any, steps) = match dim {
+        2 => {
+            let (mut c, steps) = config::<DVec2>(map)?;
+            c.seed = seed.unwrap_or(c.seed);
+            (AnyWorld::D2(World::new(c).map_err(lib_err)?), steps)
+        }
+        3 => {
+            let (mut c, steps) = config::<DVec3>(map)?;
+            c.seed = seed.unwrap_or(c.seed);
+            (AnyWorld::D3(World::new(c).map_err(lib_err)?), steps)
+        }
+        other => return fail(format!("dim must be 2 or 3, not {other}")),
+    };
+    host.scene_steps.set(steps);
+    let raw = Box::into_raw(Box::new(any));
+    host.scene_world.set(raw);
+    // SAFETY: `raw` stays alive and is reached only through the host until `load` takes it
+    // back with `Box::from_raw` after clearing the environment.
+    let ptr = match unsafe { &mut *raw } {
+        AnyWorld::D2(w) => env_of::<DVec2>(w),
+        AnyWorld::D3(w) => env_of::<DVec3>(w),
+    };
+    host.set_env(ptr);
+    Ok(WorldRef)
+}
+
+fn env_of<V: Dim>(w: &mut World<V>) -> EnvPtr {
+    let short: *mut (dyn super::host::Env<V> + '_) = w;
+    // SAFETY: lifetime erasure only; see `make_world`.
+    let erased: *mut (dyn super::host::Env<V> + 'static) = unsafe { std::mem::transmute(short) };
+    V::env_ptr(erased)
+}
+
+/// Runs `f` on the world between steps, or fails with `what` inside a step.
+macro_rules! on_world {
+    ($host:expr, $what:expr, $w:ident => $body:expr) => {
+        with_env!($host, env => match env.world() {
+            Some($w) => $body,
+            None => fail(concat!($what, " works in scene scripts (top level and on_step), not inside a kind's hooks")),
+        })
+    };
+}
+
+fn add_wall_2d_or_3d<V: Vector>(w: &mut World<V>, wall: Res<WallBox<V>>) -> Res<CritterRef> {
+    let id = w.add_wall(wall?).map_err(lib_err)?;
+    Ok(CritterRef(id))
+}
+
+fn segment<V: Vector>(a: DVec3, b: DVec3, t: f64) -> Res<WallBox<V>> {
+    if V::DIM != 2 {
+        return fail("wall(a, b) is for 2D worlds; in 3D use wall_box(min, max)");
+    }
+    let wall = WallBox::segment(DVec2::new(a.x, a.y), DVec2::new(b.x, b.y), t).map_err(lib_err)?;
+    let any: Box<dyn std::any::Any> = Box::new(wall);
+    any.downcast::<WallBox<V>>()
+        .map(|w| *w)
+        .map_or_else(|_| fail("wall(a, b) is for 2D worlds"), Ok)
+}
+
+fn dim_of<V: Vector>(_: &dyn super::host::Env<V>) -> usize {
+    V::DIM
+}
+
+/// Walls of thickness `t` lining the inside of the world box.
+fn walls_around<V: Vector>(w: &mut World<V>, t: f64) -> Res<Array> {
+    let (min, max) = (w.topology().min, w.topology().max);
+    let mut out = Array::new();
+    for axis in 0..V::DIM {
+        for low in [true, false] {
+            let (mut lo, mut hi) = (min, max);
+            if low {
+                hi.set(axis, min.get(axis) + t);
+            } else {
+                lo.set(axis, max.get(axis) - t);
+            }
+            let wall = WallBox::aligned(lo, hi).map_err(lib_err)?;
+            out.push(Dynamic::from(CritterRef(
+                w.add_wall(wall).map_err(lib_err)?,
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// Kind declarations and scene building, registered on the one engine.
+pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
+    // extends "parent";
+    let h = host.clone();
+    let registered =
+        engine.register_custom_syntax(["extends", "$string$"], false, move |_ctx, inputs| {
+            let parent = inputs[0].get_string_value().unwrap_or_default().to_string();
+            match h.kind_decl.borrow_mut().as_mut() {
+                Some(decl) => {
+                    decl.parent = Some(parent);
+                    Ok(Dynamic::UNIT)
+                }
+                None => fail("`extends` belongs at the top of a kind file"),
+            }
+        });
+    debug_assert!(registered.is_ok());
+    let h = host.clone();
+    engine.register_fn(
+        "defaults",
+        move |ctx: rhai::NativeCallContext, map: Map| -> Res<()> {
+            match h.kind_decl.borrow_mut().as_mut() {
+                Some(KindDecl { defaults, .. }) => {
+                    *defaults = Some((map, ctx.call_position()));
+                    Ok(())
+                }
+                None => fail("defaults(#{ ... }) belongs in a kind file"),
+            }
+        },
+    );
+
+    let h = host.clone();
+    engine.register_fn("world", move |map: Map| make_world(&h, &map));
+    let h = host.clone();
+    engine.register_fn("load_kind", move |name: &str| -> Res<()> {
+        ensure_kind(&h, name)
+    });
+
+    let h = host.clone();
+    engine.register_fn(
+        "wall",
+        move |_: &mut WorldRef, a: DVec3, b: DVec3| -> Res<CritterRef> {
+            on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, DEFAULT_WALL_THICKNESS)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "wall",
+        move |_: &mut WorldRef, a: DVec3, b: DVec3, t: Dynamic| -> Res<CritterRef> {
+            let t = num_or(&t, "wall thickness")?;
+            on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, t)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("wall_box", move |_: &mut WorldRef, lo: DVec3, hi: DVec3| -> Res<CritterRef> {
+        on_world!(h, "wall_box", w => add_wall_2d_or_3d(w, WallBox::aligned(from_svec(lo), from_svec(hi)).map_err(lib_err)))
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "wall_box",
+        move |_: &mut WorldRef, center: DVec3, size: DVec3, angle: Dynamic| -> Res<CritterRef> {
+            let angle = num_or(&angle, "wall_box angle")?;
+            on_world!(h, "wall_box", w => {
+                let rot = DMat3::from_rotation_z(angle);
+                let wall = rotated_box(from_svec(center), size, rot);
+                add_wall_2d_or_3d(w, wall)
+            })
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("walls_around", move |_: &mut WorldRef| -> Res<Array> {
+        on_world!(h, "walls_around", w => walls_around(w, DEFAULT_WALL_THICKNESS))
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "walls_around",
+        move |_: &mut WorldRef, t: Dynamic| -> Res<Array> {
+            let t = num_or(&t, "wall thickness")?;
+            on_world!(h, "walls_around", w => walls_around(w, t))
+        },
+    );
+
+    // Spawning patterns (scene scripts; kinds load on first use).
+    let h = host.clone();
+    engine.register_fn(
+        "row",
+        move |_: &mut WorldRef,
+              kind: &str,
+              start: DVec3,
+              step: DVec3,
+              count: INT,
+              map: Map|
+              -> Res<Array> {
+            ensure_kind(&h, kind)?;
+            let mut out = Array::new();
+            for i in 0..count.max(0) {
+                let mut m = map.clone();
+                m.insert("pos".into(), Dynamic::from(start + step * i as f64));
+                out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
+            }
+            Ok(out)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "ring",
+        move |_: &mut WorldRef,
+              kind: &str,
+              center: DVec3,
+              radius: Dynamic,
+              count: INT,
+              map: Map|
+              -> Res<Array> {
+            ensure_kind(&h, kind)?;
+            let r = num_or(&radius, "ring radius")?;
+            let mut out = Array::new();
+            for i in 0..count.max(0) {
+                let a = std::f64::consts::TAU * i as f64 / count as f64;
+                let mut m = map.clone();
+                m.insert(
+                    "pos".into(),
+                    Dynamic::from(center + DVec3::new(r * a.cos(), r * a.sin(), 0.0)),
+                );
+                out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
+            }
+            Ok(out)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "grid",
+        move |_: &mut WorldRef,
+              kind: &str,
+              lo: DVec3,
+              hi: DVec3,
+              spacing: Dynamic,
+              map: Map|
+              -> Res<Array> {
+            ensure_kind(&h, kind)?;
+            let s = num_or(&spacing, "grid spacing")?;
+            if !(s > 0.0 && s.is_finite()) {
+                return fail(format!("grid spacing {s} must be a finite number > 0"));
+            }
+            let dim = with_env!(h, env => Ok(dim_of(env)))?;
+            let count = |a: f64, b: f64| ((b - a) / s).floor().max(0.0) as i64 + 1;
+            let (nx, ny, nz) = (
+                count(lo.x, hi.x),
+                count(lo.y, hi.y),
+                if dim == 3 { count(lo.z, hi.z) } else { 1 },
+            );
+            if nx * ny * nz > 10_000_000 {
+                return fail("that grid would hold more than 10 million critters");
+            }
+            let mut out = Array::new();
+            for k in 0..nz {
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let mut m = map.clone();
+                        let p = lo + DVec3::new(i as f64 * s, j as f64 * s, k as f64 * s);
+                        m.insert("pos".into(), Dynamic::from(p));
+                        out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
+                    }
+                }
+            }
+            Ok(out)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "scatter",
+        move |_: &mut WorldRef, kind: &str, count: INT, map: Map| -> Res<Array> {
+            ensure_kind(&h, kind)?;
+            let mut out = Array::new();
+            for _ in 0..count.max(0) {
+                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, kind, &map))?);
+            }
+            Ok(out)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "stop",
+        move |_: &mut WorldRef, reason: Dynamic| -> Res<()> {
+            *h.stop.borrow_mut() = Some(reason.to_string());
+            Ok(())
+        },
+    );
+    // spawn(kind, #{ ... }). `spawn` is a reserved word in rhai, so it is custom syntax: now
+    // between steps (loading the kind on first use), queued inside a step.
+    let h = host.clone();
+    let registered = engine.register_custom_syntax(
+        ["spawn", "(", "$expr$", ",", "$expr$", ")"],
+        false,
+        move |ctx, inputs| {
+            let kind = ctx.eval_expression_tree(&inputs[0])?;
+            let map = ctx.eval_expression_tree(&inputs[1])?;
+            let Some(kind) = kind.clone().try_cast::<rhai::ImmutableString>() else {
+                return fail(format!(
+                    "spawn's first argument is the kind's name, not {}",
+                    kind.type_name()
+                ));
+            };
+            let Some(map) = map.clone().try_cast::<Map>() else {
+                return fail(format!(
+                    "spawn's second argument is a map like #{{ pos: vec(1, 2) }}, not {}",
+                    map.type_name()
+                ));
+            };
+            let in_world = with_env!(h, env => Ok(env.world().is_some()))?;
+            if in_world {
+                ensure_kind(&h, &kind)?;
+            }
+            with_env!(h, env => spawn_in(env, &h, &kind, &map))
+        },
+    );
+    debug_assert!(registered.is_ok());
+}
+
+fn rotated_box<V: Vector>(center: V, size: DVec3, rot: DMat3) -> Res<WallBox<V>> {
+    let any: &dyn std::any::Any = &rot;
+    let frame = if V::DIM == 3 {
+        any.downcast_ref::<V::Frame>().copied()
+    } else {
+        let dir = DVec2::new(rot.x_axis.x, rot.x_axis.y);
+        let d: &dyn std::any::Any = &dir;
+        d.downcast_ref::<V::Frame>().copied()
+    };
+    let frame = frame.map_or_else(|| fail("cannot orient that wall"), Ok)?;
+    WallBox::new(center, from_svec::<V>(size) * 0.5, frame).map_err(lib_err)
+}
+
+/// One critter at a random free place in the world box (seeded), clear of walls and critters.
+fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) -> Res<Dynamic> {
+    let spec = super::api::spec_from_map::<V>(kind, map)?;
+    let kid = w.kinds().id(kind).map_err(lib_err)?;
+    let r = spec.radius.unwrap_or(w.kinds().get(kid).defaults.radius);
+    let (min, max) = (w.topology().min, w.topology().max);
+    for _ in 0..1000 {
+        let mut p = V::zero();
+        for axis in 0..V::DIM {
+            p.set(axis, w.rng().uniform(min.get(axis) + r, max.get(axis) - r));
+        }
+        let free = w.critters().iter().all(|c| {
+            let d = w.topology().delta(c.pos, p);
+            match c.wall() {
+                Some(wall) => crate::contact::contact_wall_ball(wall, d, r).is_none(),
+                None => d.length() > c.radius() + r,
+            }
+        });
+        if free {
+            let mut m = map.clone();
+            m.insert("pos".into(), Dynamic::from(to_svec(p)));
+            let _ = host;
+            let spec = super::api::spec_from_map::<V>(kind, &m)?;
+            let id = w.spawn(spec).map_err(lib_err)?;
+            return Ok(Dynamic::from(CritterRef(id)));
+        }
+    }
+    fail(format!(
+        "no free place for another {kind} after 1000 tries: the world is too full"
+    ))
+}
+
+/// True when the text is a scene script (it makes a world) rather than a kind file.
+pub(crate) fn looks_like_scene(text: &str) -> bool {
+    text.lines().any(|l| {
+        let l = l.trim_start();
+        !l.starts_with("//") && l.contains("world(#{")
+    })
+}
+
+/// Replaces the value of `const NAME = ...;` at the top level for each override.
+fn apply_sets(path: &str, text: &str, sets: &[(String, String)]) -> Result<String, Error> {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    for (name, value) in sets {
+        let literal = if value.parse::<f64>().is_ok()
+            || value == "true"
+            || value == "false"
+            || value.starts_with('"')
+        {
+            value.clone()
+        } else {
+            format!("{value:?}")
+        };
+        let mut found = false;
+        for line in &mut lines {
+            let t = line.trim_start();
+            if let Some(rest) = t.strip_prefix("const ") {
+                let rest = rest.trim_start();
+                if let Some(after) = rest.strip_prefix(name.as_str()) {
+                    let after = after.trim_start();
+                    if let Some(expr) = after.strip_prefix('=') {
+                        let indent = &line[..line.len() - t.len()];
+                        let comment = expr.find("//").map(|i| &expr[i..]).unwrap_or("");
+                        *line = format!("{indent}const {name} = {literal}; {comment}");
+                        found = true;
+                        break;
+                    }
+                }
+            }
+        }
+        if !found {
+            let consts: Vec<String> = text
+                .lines()
+                .filter_map(|l| l.trim_start().strip_prefix("const "))
+                .filter_map(|r| r.split(|c: char| c == '=' || c.is_whitespace()).next())
+                .map(str::to_string)
+                .collect();
+            let mut e = ScriptError::new(
+                path,
+                format!("--set {name}: the scene has no constant {name}"),
+            );
+            e.hint = Some(if consts.is_empty() {
+                "this scene declares no constants to set".into()
+            } else {
+                format!("its constants are {}", consts.join(", "))
+            });
+            return Err(Error::from(e));
+        }
+    }
+    Ok(lines.join("\n"))
+}
+
+/// Loads and sets up a scene script.
+pub(crate) fn load(
+    path: &Path,
+    sets: &[(String, String)],
+    options: &ScriptOptions,
+) -> Result<Scene, Error> {
+    let file = path.display().to_string();
+    let text = apply_sets(&file, &read_script(path)?, sets)?;
+    let rt = Runtime::new(options, path.parent());
+    let ast = rt.compile(&file, &text)?;
+    rt.sources.borrow_mut().insert(
+        0,
+        SourceFile {
+            path: file.clone(),
+            text: text.clone(),
+        },
+    );
+
+    let mut scope = Scope::new();
+    let ran = rt.engine.run_ast_with_scope(&mut scope, &ast);
+    rt.host.clear_env();
+    let raw = rt.host.scene_world.replace(std::ptr::null_mut());
+    // SAFETY: `raw` came from `Box::into_raw` in `make_world` and nothing refers to it now.
+    let world = if raw.is_null() {
+        None
+    } else {
+        Some(*unsafe { Box::from_raw(raw) })
+    };
+    ran.map_err(|e| {
+        Error::from(eval_error(
+            &file,
+            None,
+            None,
+            &e,
+            rt.engine.max_operations(),
+        ))
+    })?;
+    let Some(world) = world else {
+        let mut e = ScriptError::new(&file, "the scene never made a world");
+        e.hint =
+            Some("start the scene with `let w = world(#{ dim: 2, size: vec(20, 10) });`".into());
+        return Err(Error::from(e));
+    };
+
+    let on_step = ast
+        .iter_functions()
+        .find(|f| f.name == "on_step")
+        .map(|f| f.params.len());
+    let on_step = match on_step {
+        None => None,
+        Some(1) => {
+            let mut constants = Scope::new();
+            for (n, is_const, value) in scope.iter() {
+                if is_const {
+                    constants.push_constant(n.to_string(), value);
+                }
+            }
+            let fns = rt.engine.optimize_ast(
+                &constants,
+                ast.clone_functions_only(),
+                rhai::OptimizationLevel::Simple,
+            );
+            Some(OnStep {
+                rt: rt.clone(),
+                ast: fns,
+                file: file.clone(),
+                line: fn_location(&text, "on_step"),
+            })
+        }
+        Some(n) => {
+            let mut e = ScriptError::new(
+                &file,
+                format!("on_step takes one parameter (world), not {n}"),
+            );
+            if let Some((l, c)) = fn_location(&text, "on_step") {
+                e.line = Some(l);
+                e.column = Some(c);
+            }
+            return Err(Error::from(e));
+        }
+    };
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or(file.clone());
+    let sources = rt.sources.borrow().clone();
+    let mut scene = Scene::new(name, world, rt.host.scene_steps.get().unwrap_or(600));
+    scene.sources = sources;
+    if let Some(on_step) = on_step {
+        scene.on_step = Some(Box::new(move |world: &mut AnyWorld| on_step.call(world)));
+    }
+    Ok(scene)
+}
+
+/// A scene's `on_step(world)`, called after every step.
+struct OnStep {
+    rt: Rc<Runtime>,
+    ast: rhai::AST,
+    file: String,
+    line: Option<(usize, usize)>,
+}
+
+impl OnStep {
+    fn call(&self, world: &mut AnyWorld) -> Result<Option<String>, Error> {
+        let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
+        let mut scope = Scope::new();
+        let run = |env: EnvPtr| {
+            self.rt.host.set_env(env);
+            let r = self.rt.engine.call_fn_with_options::<Dynamic>(
+                options,
+                &mut scope,
+                &self.ast,
+                "on_step",
+                (WorldRef,),
+            );
+            self.rt.host.clear_env();
+            r
+        };
+        let step = match world {
+            AnyWorld::D2(w) => w.step_count(),
+            AnyWorld::D3(w) => w.step_count(),
+        };
+        let result = match world {
+            AnyWorld::D2(w) => run(env_of::<DVec2>(w)),
+            AnyWorld::D3(w) => run(env_of::<DVec3>(w)),
+        };
+        result.map(drop).map_err(|e| {
+            let mut err = eval_error(
+                &self.file,
+                Some("on_step"),
+                self.line,
+                &e,
+                self.rt.engine.max_operations(),
+            );
+            err.step = Some(step);
+            Error::from(err)
+        })?;
+        Ok(self.rt.host.stop.borrow_mut().take())
+    }
+}
