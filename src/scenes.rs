@@ -285,6 +285,15 @@ impl Default for GasParams {
 /// The standard gas: `n` critters on a grid filling a square (cubic) box at the given packing
 /// fraction, velocities uniform in [-1, 1] per component from the seeded generator.
 pub fn gas<V: Vector>(p: &GasParams) -> Result<World<V>, Error> {
+    gas_with(p, "ball", |_| Ok(()))
+}
+
+/// The standard gas with critters of kind `kind`, which `prepare` registers in the empty world.
+pub fn gas_with<V: Vector>(
+    p: &GasParams,
+    kind: &str,
+    prepare: impl FnOnce(&mut World<V>) -> Result<(), Error>,
+) -> Result<World<V>, Error> {
     let dim = V::DIM as i32;
     let ball = if dim == 2 {
         PI * p.radius * p.radius
@@ -317,6 +326,7 @@ pub fn gas<V: Vector>(p: &GasParams) -> Result<World<V>, Error> {
         .seed(p.seed)
         .broad_phase(p.broad_phase);
     let mut world = World::new(config)?;
+    prepare(&mut world)?;
     if walled {
         for axis in 0..V::DIM {
             for side_at in [-t, side] {
@@ -340,7 +350,7 @@ pub fn gas<V: Vector>(p: &GasParams) -> Result<World<V>, Error> {
             vel.set(axis, world.rng().uniform(-1.0, 1.0));
         }
         world.spawn(
-            CritterSpec::ball(pos)
+            CritterSpec::new(kind, pos)
                 .vel(vel)
                 .radius(p.radius)
                 .restitution(p.restitution),

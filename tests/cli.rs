@@ -123,3 +123,70 @@ fn help_explains_the_run_options() {
         assert!(out.contains(flag), "{flag} missing from --help");
     }
 }
+
+#[test]
+fn every_shipped_scene_script_runs_from_the_command_line() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes");
+    let mut ran = 0;
+    for entry in std::fs::read_dir(&dir).expect("scripts/scenes exists") {
+        let path = entry.expect("a directory entry").path();
+        let o = critterbox(&["run", path.to_str().expect("utf-8 path"), "--steps", "50"]);
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+        assert!(
+            field(&stdout(&o), "scene").contains("2D")
+                || field(&stdout(&o), "scene").contains("3D")
+        );
+        ran += 1;
+    }
+    assert!(ran >= 5, "expected the lecture's five scenes, found {ran}");
+}
+
+#[test]
+fn set_overrides_a_scene_constant_and_rejects_unknown_ones() {
+    let cradle = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/scenes/cradle.rhai");
+    let o = critterbox(&["run", cradle, "--set", "SPEED=2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Five balls of mass 0.125 struck at 2: the momentum is 0.25 whichever ball carries it.
+    assert!(
+        field(&stdout(&o), "momentum").starts_with("(2.500000e-1,"),
+        "{}",
+        stdout(&o)
+    );
+    let o = critterbox(&["run", cradle, "--set", "NOPE=1"]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("no constant NOPE") && err.contains("SPEED"),
+        "{err}"
+    );
+}
+
+#[test]
+fn check_passes_shipped_scripts_and_fails_a_broken_one_with_its_line() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mut args = vec!["check".to_string()];
+    for sub in ["scripts/scenes", "scripts/kinds"] {
+        for entry in std::fs::read_dir(format!("{root}/{sub}")).expect("scripts exist") {
+            args.push(entry.expect("entry").path().display().to_string());
+        }
+    }
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = critterbox(&refs);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        stdout(&o)
+            .lines()
+            .filter(|l| l.ends_with(")") && l.contains(" ok "))
+            .count(),
+        args.len() - 1
+    );
+
+    let dir = std::env::temp_dir().join(format!("critterbox-cli-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let broken = dir.join("broken.rhai");
+    std::fs::write(&broken, "fn collide(me, other) {\n    let x = ;\n}\n").expect("write");
+    let o = critterbox(&["check", broken.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("broken.rhai:2:"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -17,11 +17,23 @@ pub struct RunArgs {
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub sets: Vec<String>,
     /// Most operations one script call may run before it is stopped (endless-loop guard).
-    #[arg(long, default_value_t = Limits::default().max_operations)]
+    #[arg(long, default_value_t = Limits::default().max_operations, help_heading = "Script limits")]
     pub max_ops: u64,
     /// Most spawns scripts may request in one step.
-    #[arg(long, default_value_t = Limits::default().max_spawns_per_step)]
+    #[arg(long, default_value_t = Limits::default().max_spawns_per_step, help_heading = "Script limits")]
     pub max_spawns: u64,
+    /// Deepest nesting of function calls in a script.
+    #[arg(long, default_value_t = Limits::default().max_call_levels, help_heading = "Script limits")]
+    pub max_call_depth: usize,
+    /// Longest string a script may build (bytes).
+    #[arg(long, default_value_t = Limits::default().max_string_size, help_heading = "Script limits")]
+    pub max_string: usize,
+    /// Longest array a script may build.
+    #[arg(long, default_value_t = Limits::default().max_array_size, help_heading = "Script limits")]
+    pub max_array: usize,
+    /// Largest map a script may build.
+    #[arg(long, default_value_t = Limits::default().max_map_size, help_heading = "Script limits")]
+    pub max_map: usize,
     /// List the built-in scenes and exit.
     #[arg(long)]
     pub list: bool,
@@ -138,7 +150,10 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         limits: Limits {
             max_operations: args.max_ops,
             max_spawns_per_step: args.max_spawns,
-            ..Limits::default()
+            max_call_levels: args.max_call_depth,
+            max_string_size: args.max_string,
+            max_array_size: args.max_array,
+            max_map_size: args.max_map,
         },
         seed: args.seed,
         ..ScriptOptions::default()

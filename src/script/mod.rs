@@ -135,6 +135,28 @@ pub fn load_scene(
     scene::load(path, sets, options)
 }
 
+/// A world that script kinds can be loaded into: `World<DVec2>` and `World<DVec3>`.
+pub trait ScriptWorld {
+    /// Loads the kind file at `path` (and the kinds it extends, from the same folder) into the
+    /// world, for a Rust program that builds its own world.
+    fn load_kind(
+        &mut self,
+        path: &Path,
+        options: &ScriptOptions,
+    ) -> Result<crate::kind::KindId, Error>;
+}
+
+impl<V: host::Dim> ScriptWorld for crate::world::World<V> {
+    fn load_kind(
+        &mut self,
+        path: &Path,
+        options: &ScriptOptions,
+    ) -> Result<crate::kind::KindId, Error> {
+        let rt = Runtime::new(options, path.parent());
+        kind::load_into(&rt, self, &path.display().to_string())
+    }
+}
+
 /// Compiles and checks script files without running a world: scenes are set up (not stepped),
 /// kinds are loaded and their hooks checked. Returns one line per file checked.
 pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, Error> {
