@@ -14,6 +14,7 @@ fn main() -> ExitCode {
         // A closed pipe (`critterbox run | head`) is the reader's choice, not a failure.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
+            let _ = out.flush(); // what was printed comes before the error
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }

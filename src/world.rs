@@ -869,15 +869,45 @@ impl<V: Vector> World<V> {
             return Ok(false);
         }
         let (kind, id, step) = (c.kind, c.id, self.step_count);
+        let arg_id = a.id;
         let hooks = self.kinds.get(kind).hooks.clone();
+        let events_before = self.events.collisions.len();
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,
             other: arg,
         };
-        hooks
+        let handled = hooks
             .collide(&mut ctx)
-            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))?;
+        if handled && self.events.collisions.len() == events_before {
+            // A hook that handled the pair its own way (a bullet's hit, a basket's catch) is a
+            // collision too, with no impulse.
+            self.record_hook_collision(id, arg_id);
+        }
+        Ok(handled)
+    }
+
+    fn record_hook_collision(&mut self, caller: CritterId, arg: CritterId) {
+        let (Some(c), Some(a)) = (self.critters.get(caller), self.critters.get(arg)) else {
+            return;
+        };
+        let d = self.topo.delta(c.pos, a.pos);
+        let (normal, point) = match crate::response::contact_between(&self.topo, c, a) {
+            Some(contact) => (contact.normal, c.pos + contact.point),
+            None => {
+                let len = d.length();
+                let n = if len > 0.0 { d / len } else { V::unit_x() };
+                (n, c.pos + d * 0.5)
+            }
+        };
+        self.events.collisions.push(crate::context::CollisionEvent {
+            caller,
+            arg,
+            point,
+            normal,
+            impulse: 0.0,
+        });
     }
 
     fn stage_lifecycle(&mut self) -> Result<(), Error> {

@@ -412,7 +412,11 @@ fn bullet_damages_a_target_and_dies_without_bouncing_it() {
     assert!(world.get(b).is_none(), "the bullet died");
     assert_eq!(world.events().damages, vec![(t, 1.0)]);
     assert_eq!(world.events().deaths, vec![b]);
-    assert!(world.events().collisions.is_empty(), "no default collision");
+    // The hit is reported as a collision of the bullet with the target, with no impulse.
+    let events = &world.events().collisions;
+    assert_eq!(events.len(), 1, "one collision: the hit");
+    assert_eq!((events[0].caller, events[0].arg), (b, t));
+    assert_eq!(events[0].impulse, 0.0, "no default collision, no impulse");
 }
 
 #[test]

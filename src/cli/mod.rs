@@ -4,6 +4,7 @@
 
 pub mod check;
 pub mod run;
+pub mod test;
 
 use clap::{Parser, Subcommand};
 
@@ -23,6 +24,8 @@ pub enum Command {
     Run(run::RunArgs),
     /// Compile and check scene and kind scripts without running them (for editors and CI).
     Check(check::CheckArgs),
+    /// Run script tests: every `fn test_*()` in scripts/tests/*.rhai.
+    Test(test::TestArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
@@ -30,6 +33,7 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Run(args)) => run::run(&args, out),
         Some(Command::Check(args)) => check::run(&args, out),
+        Some(Command::Test(args)) => test::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }

@@ -280,6 +280,7 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     register_critter(&mut engine, host);
     register_world(&mut engine, host);
     super::scene::register(&mut engine, host);
+    super::testing::register(&mut engine, host);
     engine
 }
 

@@ -224,8 +224,13 @@ pub(crate) struct Host {
     pub runtime: super::RuntimeLink,
     /// While a kind file's top level runs: what it declares.
     pub kind_decl: RefCell<Option<super::kind::KindDecl>>,
-    /// The world a scene script is building (owned here while the scene's top level runs).
-    pub scene_world: Cell<*mut crate::scenes::AnyWorld>,
+    /// The scene a script is building or a test is running (owned here while it runs; taken
+    /// back with `Box::from_raw` by whoever finishes the run).
+    pub scene_world: Cell<*mut crate::scenes::Scene>,
+    /// True while test scripts run: they may load scenes and step worlds.
+    pub testing: Cell<bool>,
+    /// A test's wall-clock deadline.
+    pub deadline: Cell<Option<std::time::Instant>>,
     /// Set by `world.stop(reason)`.
     pub stop: RefCell<Option<String>>,
     /// Steps the scene asked for (`world(#{ steps: ... })`).
@@ -244,6 +249,8 @@ impl Host {
             runtime: RefCell::new(std::rc::Weak::new()),
             kind_decl: RefCell::new(None),
             scene_world: Cell::new(std::ptr::null_mut()),
+            testing: Cell::new(false),
+            deadline: Cell::new(None),
             stop: RefCell::new(None),
             scene_steps: Cell::new(None),
             seed_override: Cell::new(None),
@@ -266,6 +273,27 @@ impl Host {
     /// calls). The caller keeps the pointee alive and otherwise untouched until then.
     pub fn set_env(&self, ptr: EnvPtr) {
         self.env.set(ptr);
+    }
+
+    /// Takes back the scene a script made or loaded, and points scripts at nothing.
+    pub fn take_scene(&self) -> Option<crate::scenes::Scene> {
+        self.clear_env();
+        let raw = self.scene_world.replace(std::ptr::null_mut());
+        // SAFETY: `raw` came from `Box::into_raw` when the scene was stored, and the environment
+        // pointing into it has just been cleared.
+        (!raw.is_null()).then(|| *unsafe { Box::from_raw(raw) })
+    }
+
+    /// Stores `scene` as the one scripts act on, and points them at its world.
+    pub fn put_scene(&self, scene: crate::scenes::Scene) {
+        let raw = Box::into_raw(Box::new(scene));
+        self.scene_world.set(raw);
+        // SAFETY: `raw` stays alive until `take_scene`.
+        let ptr = match unsafe { &mut (*raw).world } {
+            crate::scenes::AnyWorld::D2(w) => env_of::<DVec2>(w),
+            crate::scenes::AnyWorld::D3(w) => env_of::<DVec3>(w),
+        };
+        self.set_env(ptr);
     }
 
     /// Ends [`Host::set_env`].
@@ -319,3 +347,11 @@ macro_rules! with_env {
     };
 }
 pub(crate) use with_env;
+
+/// The environment pointer of a world (lifetime erased; see [`Host::enter`]).
+pub(crate) fn env_of<V: Dim>(w: &mut World<V>) -> EnvPtr {
+    let short: *mut (dyn Env<V> + '_) = w;
+    // SAFETY: lifetime erasure only; callers keep `w` alive while the pointer is in use.
+    let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
+    V::env_ptr(erased)
+}

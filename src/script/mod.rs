@@ -13,6 +13,7 @@ pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
 pub(crate) mod scene;
+pub mod testing;
 
 use crate::error::{Error, ScriptError};
 use crate::scenes::Scene;
@@ -76,6 +77,8 @@ pub(crate) struct Runtime {
     pub kinds: RefCell<BTreeMap<String, Rc<kind::ScriptKindDef>>>,
     /// Every file loaded, in load order.
     pub sources: RefCell<Vec<SourceFile>>,
+    /// The limits the engine was built with.
+    pub limits: Limits,
 }
 
 impl Runtime {
@@ -96,6 +99,7 @@ impl Runtime {
             kind_dirs,
             kinds: RefCell::new(BTreeMap::new()),
             sources: RefCell::new(Vec::new()),
+            limits: options.limits.clone(),
         });
         *rt.host.runtime.borrow_mut() = Rc::downgrade(&rt);
         rt

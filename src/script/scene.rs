@@ -3,7 +3,7 @@
 
 use super::api::{fail, from_svec, num_or, spawn_in, to_svec, CritterRef, Res, WorldRef};
 use super::errors::{eval_error, fn_location};
-use super::host::{with_env, Dim, EnvPtr, Host};
+use super::host::{env_of, with_env, EnvPtr, Host};
 use super::kind::{load_into, KindDecl};
 use super::{read_script, Runtime, ScriptOptions, SourceFile};
 use crate::border::Border;
@@ -152,23 +152,8 @@ fn make_world(host: &Rc<Host>, map: &Map) -> Res<WorldRef> {
         other => return fail(format!("dim must be 2 or 3, not {other}")),
     };
     host.scene_steps.set(steps);
-    let raw = Box::into_raw(Box::new(any));
-    host.scene_world.set(raw);
-    // SAFETY: `raw` stays alive and is reached only through the host until `load` takes it
-    // back with `Box::from_raw` after clearing the environment.
-    let ptr = match unsafe { &mut *raw } {
-        AnyWorld::D2(w) => env_of::<DVec2>(w),
-        AnyWorld::D3(w) => env_of::<DVec3>(w),
-    };
-    host.set_env(ptr);
+    host.put_scene(Scene::new("world", any, steps.unwrap_or(600)));
     Ok(WorldRef)
-}
-
-fn env_of<V: Dim>(w: &mut World<V>) -> EnvPtr {
-    let short: *mut (dyn super::host::Env<V> + '_) = w;
-    // SAFETY: lifetime erasure only; see `make_world`.
-    let erased: *mut (dyn super::host::Env<V> + 'static) = unsafe { std::mem::transmute(short) };
-    V::env_ptr(erased)
 }
 
 /// Runs `f` on the world between steps, or fails with `what` inside a step.
@@ -564,14 +549,7 @@ pub(crate) fn load(
 
     let mut scope = Scope::new();
     let ran = rt.engine.run_ast_with_scope(&mut scope, &ast);
-    rt.host.clear_env();
-    let raw = rt.host.scene_world.replace(std::ptr::null_mut());
-    // SAFETY: `raw` came from `Box::into_raw` in `make_world` and nothing refers to it now.
-    let world = if raw.is_null() {
-        None
-    } else {
-        Some(*unsafe { Box::from_raw(raw) })
-    };
+    let world = rt.host.take_scene().map(|scene| scene.world);
     ran.map_err(|e| {
         Error::from(eval_error(
             &file,

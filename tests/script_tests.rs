@@ -1,0 +1,32 @@
+//! Runs every script test (`fn test_*()` in scripts/tests/*.rhai) as its own cargo test, so
+//! `cargo test` and `cargo nextest run` cover the rules written in rhai by name.
+
+use critterbox::script::testing::{discover, find_test_files, run_one, TestOptions};
+use libtest_mimic::{Arguments, Failed, Trial};
+use std::path::PathBuf;
+
+fn main() {
+    let args = Arguments::from_args();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    // Script tests name files relative to the crate root (load_scene("scripts/scenes/...")).
+    std::env::set_current_dir(&root).expect("the crate root exists");
+    let files =
+        find_test_files(&[PathBuf::from("scripts/tests")]).expect("scripts/tests is readable");
+    let trials = discover(&files, None)
+        .into_iter()
+        .map(|case| {
+            let name = case.id().replace(".rhai::", "::").replace('/', "::");
+            Trial::test(name, move || {
+                let options = TestOptions {
+                    jobs: 1,
+                    ..TestOptions::default()
+                };
+                match run_one(&case, &options).failure {
+                    None => Ok(()),
+                    Some(f) => Err(Failed::from(f.to_string())),
+                }
+            })
+        })
+        .collect();
+    libtest_mimic::run(&args, trials).exit();
+}
