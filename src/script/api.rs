@@ -24,6 +24,14 @@ pub struct WorldRef;
 pub(crate) type Res<T> = Result<T, Box<EvalAltResult>>;
 
 /// A runtime error with message `msg` (rhai adds the position of the call).
+/// Separates a message from its hint inside a runtime error's text (see `errors::eval_error`).
+pub(crate) const HINT_MARK: char = '\u{1f}';
+
+/// A runtime error with a message and a hint for the script's author.
+pub(crate) fn fail_hint<T>(msg: impl Into<String>, hint: impl Into<String>) -> Res<T> {
+    fail(format!("{}{HINT_MARK}{}", msg.into(), hint.into()))
+}
+
 pub(crate) fn fail<T>(msg: impl Into<String>) -> Res<T> {
     Err(Box::new(EvalAltResult::ErrorRuntime(
         Dynamic::from(msg.into()),
@@ -193,7 +201,8 @@ pub(crate) fn props_from_map(map: &Map) -> Res<Props> {
     Ok(props)
 }
 
-fn lib_err(e: crate::Error) -> Box<EvalAltResult> {
+/// A library error as a script error (rhai adds the position of the call).
+pub(crate) fn lib_err(e: crate::Error) -> Box<EvalAltResult> {
     Box::new(EvalAltResult::ErrorRuntime(
         Dynamic::from(e.to_string()),
         Position::NONE,
@@ -235,7 +244,7 @@ pub(crate) fn spawn_in<V: Vector>(
     count_spawn(host, env.step_count())?;
     env.kinds().id(kind).map_err(lib_err)?;
     let spec = spec_from_map::<V>(kind, map)?;
-    match env.spawn(spec).map_err(lib_err)? {
+    match env.spawn(spec).map_err(|e| host.carry(e))? {
         Some(id) => Ok(Dynamic::from(CritterRef(id))),
         None => Ok(Dynamic::UNIT),
     }
@@ -405,11 +414,16 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
                 c.props.insert(name.to_string(), prop);
                 Ok(())
             }
-            Some(_) => fail(format!(
-                "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, health, \
-                 restitution, priority, fixed); declare it in the kind's props or the spawn map, or add it with \
-                 set_prop(\"{name}\", value)"
-            )),
+            Some(_) => fail_hint(
+                format!(
+                    "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
+                     health, restitution, priority, fixed)"
+                ),
+                format!(
+                    "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
+                     set_prop(\"{name}\", value)"
+                ),
+            ),
             None => fail("critters are read-only in collides_with"),
         }
     })
@@ -538,6 +552,25 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
         "set_prop",
         move |r: &mut CritterRef, name: &str, value: Dynamic| -> Res<()> {
             set_prop(&h, r.0, name, &value, true)
+        },
+    );
+    // rhai gives every value a `tag`; for critters, `tag` is a user property like any other.
+    let h = host.clone();
+    engine.register_get("tag", move |r: &mut CritterRef| -> Res<Dynamic> {
+        let id = r.0;
+        with_env!(h, env => match env.critter(id) {
+            Some(c) => c.props.get("tag").map_or_else(
+                || fail(format!("critter {id} has no property 'tag'")),
+                |p| Ok(from_prop(p)),
+            ),
+            None => Err(gone(id)),
+        })
+    });
+    let h = host.clone();
+    engine.register_set(
+        "tag",
+        move |r: &mut CritterRef, value: Dynamic| -> Res<()> {
+            set_prop(&h, r.0, "tag", &value, false)
         },
     );
     let h = host.clone();

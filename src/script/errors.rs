@@ -50,7 +50,12 @@ pub(crate) fn eval_error(
     max_operations: u64,
 ) -> ScriptError {
     let inner = e.unwrap_inner();
-    let mut err = ScriptError::new(file, bare(inner));
+    let text = bare(inner);
+    let (message, carried_hint) = match text.split_once(super::api::HINT_MARK) {
+        Some((m, h)) => (m.to_string(), Some(h.to_string())),
+        None => (text, None),
+    };
+    let mut err = ScriptError::new(file, message);
     err.hook = hook.map(str::to_string);
     // The innermost position is where it went wrong; fall back to outer ones, then to the hook.
     let mut pos = inner.position();
@@ -86,7 +91,7 @@ pub(crate) fn eval_error(
         )),
         EvalAltResult::ErrorStackOverflow(_) => Some("a function calls itself without end, or calls nest too deep".into()),
         EvalAltResult::ErrorDataTooLarge(..) => Some("a string, array or map grew past the sandbox limit".into()),
-        _ => None,
+        _ => carried_hint,
     };
     err
 }

@@ -237,6 +237,9 @@ pub(crate) struct Host {
     pub scene_steps: Cell<Option<u64>>,
     /// `--seed`, which wins over the scene's own seed.
     pub seed_override: Cell<Option<u64>>,
+    /// A located error from deeper down (a kind file a scene loaded, a hook run by a spawn),
+    /// kept whole while rhai carries its text up through the calling script.
+    pub stashed: RefCell<Option<Box<crate::error::ScriptError>>>,
 }
 
 impl Host {
@@ -254,6 +257,7 @@ impl Host {
             stop: RefCell::new(None),
             scene_steps: Cell::new(None),
             seed_override: Cell::new(None),
+            stashed: RefCell::new(None),
         }
     }
 
@@ -294,6 +298,40 @@ impl Host {
             crate::scenes::AnyWorld::D3(w) => env_of::<DVec3>(w),
         };
         self.set_env(ptr);
+    }
+
+    /// The error as rhai should carry it; a located script error is also kept whole, so
+    /// [`Host::locate`] can report it with its own file and line.
+    pub fn carry(&self, e: crate::error::Error) -> Box<rhai::EvalAltResult> {
+        let text = match e {
+            crate::error::Error::Script(s) => {
+                let text = s.to_string();
+                *self.stashed.borrow_mut() = Some(s);
+                text
+            }
+            other => other.to_string(),
+        };
+        Box::new(rhai::EvalAltResult::ErrorRuntime(
+            rhai::Dynamic::from(text),
+            rhai::Position::NONE,
+        ))
+    }
+
+    /// The kept error if `e` is the one it carried up, else `fallback()`.
+    pub fn locate(
+        &self,
+        e: &rhai::EvalAltResult,
+        fallback: impl FnOnce() -> crate::error::ScriptError,
+    ) -> crate::error::ScriptError {
+        let kept = self.stashed.borrow_mut().take();
+        match (kept, e.unwrap_inner()) {
+            (Some(s), rhai::EvalAltResult::ErrorRuntime(v, _))
+                if v.to_string() == s.to_string() =>
+            {
+                *s
+            }
+            _ => fallback(),
+        }
     }
 
     /// Ends [`Host::set_env`].

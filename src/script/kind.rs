@@ -134,7 +134,9 @@ pub(crate) fn load_def(rt: &Runtime, name_or_path: &str) -> Result<Rc<ScriptKind
     }
     let file = path.display().to_string();
     let text = read_script(&path)?;
-    let ast = rt.compile(&file, &text)?;
+    let ast = rt
+        .compile(&file, &text)
+        .map_err(|e| in_kind(e, &file, &name))?;
 
     // Run the top level once, with no world reachable: it declares, it does not act.
     *rt.host.kind_decl.borrow_mut() = Some(KindDecl::default());
@@ -241,7 +243,12 @@ pub(crate) fn load_def(rt: &Runtime, name_or_path: &str) -> Result<Rc<ScriptKind
 
 fn in_kind(e: Error, file: &str, name: &str) -> Error {
     match e {
-        Error::Script(s) => Error::Script(s),
+        Error::Script(mut s) => {
+            if s.file == file {
+                s.kind.get_or_insert_with(|| name.to_string());
+            }
+            Error::Script(s)
+        }
         other => {
             let mut err = ScriptError::new(file, other.to_string());
             err.kind = Some(name.to_string());

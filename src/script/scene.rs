@@ -1,7 +1,7 @@
 //! Scene scripts: the functions that build a world (`world(#{ ... })`, walls, spawning patterns,
 //! `load_kind`), kind declarations (`extends`, `defaults`), and loading a scene file.
 
-use super::api::{fail, from_svec, num_or, spawn_in, to_svec, CritterRef, Res, WorldRef};
+use super::api::{fail, from_svec, lib_err, num_or, spawn_in, to_svec, CritterRef, Res, WorldRef};
 use super::errors::{eval_error, fn_location};
 use super::host::{env_of, with_env, EnvPtr, Host};
 use super::kind::{load_into, KindDecl};
@@ -13,7 +13,7 @@ use crate::vector::Vector;
 use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
 use crate::world::{World, WorldConfig};
 use glam::{DMat3, DVec2, DVec3};
-use rhai::{Array, CallFnOptions, Dynamic, Engine, EvalAltResult, Map, Position, Scope, INT};
+use rhai::{Array, CallFnOptions, Dynamic, Engine, Map, Scope, INT};
 use std::path::Path;
 use std::rc::Rc;
 
@@ -29,17 +29,6 @@ fn runtime(host: &Host) -> Res<Rc<Runtime>> {
         .map_or_else(|| fail("the script runtime is gone"), Ok)
 }
 
-fn lib_err(e: Error) -> Box<EvalAltResult> {
-    let text = match e {
-        Error::Script(s) => s.to_string(),
-        other => other.to_string(),
-    };
-    Box::new(EvalAltResult::ErrorRuntime(
-        Dynamic::from(text),
-        Position::NONE,
-    ))
-}
-
 /// Loads kind `name` into whatever world scripts act on, unless it is there already.
 fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<()> {
     let known = with_env!(host, env => Ok(env.kinds().id(name).is_ok()))?;
@@ -48,7 +37,7 @@ fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<()> {
     }
     let rt = runtime(host)?;
     with_env!(host, env => match env.world() {
-        Some(world) => load_into(&rt, world, name).map(|_| ()).map_err(lib_err),
+        Some(world) => load_into(&rt, world, name).map(|_| ()).map_err(|e| host.carry(e)),
         None => fail(format!(
             "unknown kind '{name}': kinds are loaded between steps; call load_kind(\"{name}\") in the scene script"
         )),
@@ -400,6 +389,26 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
         ["spawn", "(", "$expr$", ",", "$expr$", ")"],
         false,
         move |ctx, inputs| {
+            // Errors raised here have no position of their own: give them the spawn's.
+            let pos = inputs[0].position();
+            spawn_syntax(&h, ctx, inputs).map_err(|mut e| {
+                if e.position().is_none() {
+                    e.set_position(pos);
+                }
+                e
+            })
+        },
+    );
+    debug_assert!(registered.is_ok());
+}
+
+fn spawn_syntax(
+    h: &Rc<Host>,
+    ctx: &mut rhai::EvalContext,
+    inputs: &[rhai::Expression],
+) -> Res<Dynamic> {
+    {
+        {
             let kind = ctx.eval_expression_tree(&inputs[0])?;
             let map = ctx.eval_expression_tree(&inputs[1])?;
             let Some(kind) = kind.clone().try_cast::<rhai::ImmutableString>() else {
@@ -416,12 +425,11 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
             };
             let in_world = with_env!(h, env => Ok(env.world().is_some()))?;
             if in_world {
-                ensure_kind(&h, &kind)?;
+                ensure_kind(h, &kind)?;
             }
-            with_env!(h, env => spawn_in(env, &h, &kind, &map))
-        },
-    );
-    debug_assert!(registered.is_ok());
+            with_env!(h, env => spawn_in(env, h, &kind, &map))
+        }
+    }
 }
 
 fn rotated_box<V: Vector>(center: V, size: DVec3, rot: DMat3) -> Res<WallBox<V>> {
@@ -458,9 +466,8 @@ fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) 
         if free {
             let mut m = map.clone();
             m.insert("pos".into(), Dynamic::from(to_svec(p)));
-            let _ = host;
             let spec = super::api::spec_from_map::<V>(kind, &m)?;
-            let id = w.spawn(spec).map_err(lib_err)?;
+            let id = w.spawn(spec).map_err(|e| host.carry(e))?;
             return Ok(Dynamic::from(CritterRef(id)));
         }
     }
@@ -551,13 +558,9 @@ pub(crate) fn load(
     let ran = rt.engine.run_ast_with_scope(&mut scope, &ast);
     let world = rt.host.take_scene().map(|scene| scene.world);
     ran.map_err(|e| {
-        Error::from(eval_error(
-            &file,
-            None,
-            None,
-            &e,
-            rt.engine.max_operations(),
-        ))
+        Error::from(rt.host.locate(&e, || {
+            eval_error(&file, None, None, &e, rt.engine.max_operations())
+        }))
     })?;
     let Some(world) = world else {
         let mut e = ScriptError::new(&file, "the scene never made a world");
