@@ -165,13 +165,15 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
     );
     let scene = rt.host.take_scene();
     result.map(drop).map_err(|e| {
-        let mut err = eval_error(
-            &file,
-            Some(&case.name),
-            super::errors::fn_location(&text, &case.name),
-            &e,
-            rt.engine.max_operations(),
-        );
+        let mut err = rt.host.locate(&e, || {
+            eval_error(
+                &file,
+                Some(&case.name),
+                super::errors::fn_location(&text, &case.name),
+                &e,
+                rt.engine.max_operations(),
+            )
+        });
         if err.step.is_none() {
             err.step = scene.as_ref().map(|s| s.world.step_count());
         }
