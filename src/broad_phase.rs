@@ -9,7 +9,9 @@
 //! output order depends only on the objects, never on a hash or a thread count.
 //!
 //! For small scenes a direct loop over all pairs is cheaper than building a grid; [`SMALL_N`] is
-//! where `benches/step.rs` measured the two to cross.
+//! where `benches/step.rs` measured the two to cross. Above it, [`BroadPhaseMode::Auto`] keeps a
+//! Verlet list: the grid is built with boxes widened by a skin, its pairs are kept, and each step
+//! re-tests only those until something has moved more than half the skin.
 //!
 //! Walls never pair with walls.
 
@@ -35,32 +37,50 @@ pub struct BroadObject<V> {
 /// Which algorithm to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BroadPhaseMode {
-    /// Direct loop for small scenes, grid otherwise.
+    /// Direct loop for small scenes, otherwise the grid with a Verlet list (pairs kept while
+    /// nothing has moved far).
     #[default]
     Auto,
-    /// Always the grid.
+    /// The grid rebuilt every step.
     Grid,
     /// Always the direct all-pairs loop (the naive baseline).
     AllPairs,
 }
 
-#[derive(Default)]
-struct Level {
+/// One level of the grid: its cells and its members, copied in cell order.
+struct Level<V> {
     inv_cell: [f64; 3],
     dims: [usize; 3],
     wrap: [bool; 3],
     /// Object indices on this level.
     members: Vec<u32>,
-    /// Cell key of each member (parallel to `members`, then to `sorted`).
+    /// Cell key and cell coordinates of each member (parallel to `members`).
     keys: Vec<u32>,
+    coords: Vec<[u32; 3]>,
     /// `start[k]..start[k + 1]` indexes `sorted` for cell `k`.
     start: Vec<u32>,
-    /// Members ordered by cell.
-    sorted: Vec<u32>,
-    /// Cell key of each entry of `sorted`.
+    /// The members' objects in cell order, so the pair loops read memory in order.
+    sorted: Vec<BroadObject<V>>,
+    /// Cell key and coordinates of each entry of `sorted`.
     sorted_keys: Vec<u32>,
-    /// Scratch for the counting sort.
-    fill: Vec<u32>,
+    sorted_coords: Vec<[u32; 3]>,
+}
+
+impl<V> Default for Level<V> {
+    fn default() -> Self {
+        Level {
+            inv_cell: [0.0; 3],
+            dims: [1; 3],
+            wrap: [false; 3],
+            members: Vec::new(),
+            keys: Vec::new(),
+            coords: Vec::new(),
+            start: Vec::new(),
+            sorted: Vec::new(),
+            sorted_keys: Vec::new(),
+            sorted_coords: Vec::new(),
+        }
+    }
 }
 
 /// `i` mod `n` for `i` within one period of `[0, n)`, the general case otherwise.
@@ -84,9 +104,9 @@ fn wrap_index(i: i64, n: usize) -> usize {
     }
 }
 
-impl Level {
+impl<V: Vector> Level<V> {
     #[inline]
-    fn coords<V: Vector>(&self, topo: &Topology<V>, p: V) -> [usize; 3] {
+    fn coords(&self, topo: &Topology<V>, p: V) -> [usize; 3] {
         let mut c = [0usize; 3];
         for (axis, slot) in c.iter_mut().enumerate().take(V::DIM) {
             let n = self.dims[axis];
@@ -146,7 +166,7 @@ impl Level {
 
     /// Per axis, the first cell and the number of cells of this level whose members may overlap
     /// the box of `b` (members are at most one cell wide). Never more cells than the axis has.
-    fn footprint<V: Vector>(&self, topo: &Topology<V>, b: &BroadObject<V>) -> [(i64, usize); 3] {
+    fn footprint(&self, topo: &Topology<V>, b: &BroadObject<V>) -> [(i64, usize); 3] {
         let mut out = [(0i64, 1usize); 3];
         for (axis, slot) in out.iter_mut().enumerate().take(V::DIM) {
             let n = self.dims[axis];
@@ -190,23 +210,14 @@ impl Level {
     }
 
     #[inline]
-    fn decode(&self, key: usize) -> [usize; 3] {
-        let plane = self.dims[0] * self.dims[1];
-        let z = key / plane;
-        let rest = key - z * plane;
-        let y = rest / self.dims[0];
-        [rest - y * self.dims[0], y, z]
-    }
-
-    #[inline]
-    fn cell(&self, key: usize) -> &[u32] {
+    fn cell(&self, key: usize) -> &[BroadObject<V>] {
         &self.sorted[self.start[key] as usize..self.start[key + 1] as usize]
     }
 
     /// Offsets to visit: `forward` = only those after (0,0,0) in (z, y, x) order.
-    fn offsets(&self, dim: usize, forward: bool) -> Vec<[i32; 3]> {
+    fn offsets(&self, forward: bool) -> Vec<[i32; 3]> {
         let range = |axis: usize| -> Vec<i32> {
-            if axis < dim && self.dims[axis] > 1 {
+            if axis < V::DIM && self.dims[axis] > 1 {
                 vec![-1, 0, 1]
             } else {
                 vec![0]
@@ -225,19 +236,149 @@ impl Level {
         }
         out
     }
+
+    /// Sizes the level's grid for cells at least `cell` wide (and at most `limit` cells), sorts
+    /// its members by cell, and returns the cell width used.
+    fn build(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        mut cell: f64,
+        limit: f64,
+    ) -> f64 {
+        let size = topo.size();
+        loop {
+            let mut cells = 1.0;
+            for axis in 0..3 {
+                self.wrap[axis] = false;
+                if axis >= V::DIM {
+                    self.dims[axis] = 1;
+                    self.inv_cell[axis] = 0.0;
+                    continue;
+                }
+                let len = size.get(axis);
+                if topo.wraps() {
+                    let mut n = (len / cell).floor().max(1.0) as usize;
+                    if n < 3 {
+                        n = 1;
+                    }
+                    self.dims[axis] = n;
+                    self.wrap[axis] = n > 1;
+                    self.inv_cell[axis] = n as f64 / len;
+                } else {
+                    let n = (len / cell).ceil().clamp(1.0, 1e9) as usize;
+                    self.dims[axis] = n;
+                    self.inv_cell[axis] = 1.0 / cell;
+                }
+                cells *= self.dims[axis] as f64;
+            }
+            if cells <= limit {
+                break;
+            }
+            cell *= (cells / limit).powf(1.0 / V::DIM as f64) * 1.01;
+        }
+
+        // Counting sort of the members by cell key, copying the objects into cell order.
+        let ncells = self.dims[0] * self.dims[1] * self.dims[2];
+        self.start.clear();
+        self.start.resize(ncells + 1, 0);
+        self.keys.clear();
+        self.coords.clear();
+        for &i in &self.members {
+            let c = self.coords(topo, objs[i as usize].center);
+            let k = self.key(c);
+            self.keys.push(k as u32);
+            self.coords.push([c[0] as u32, c[1] as u32, c[2] as u32]);
+            self.start[k] += 1;
+        }
+        // Exclusive prefix sum, carried in a register (a loop through memory stalls on each add).
+        let mut acc = 0u32;
+        for s in self.start.iter_mut() {
+            let count = *s;
+            *s = acc;
+            acc += count;
+        }
+        let m = self.members.len();
+        let filler = BroadObject {
+            center: V::zero(),
+            half: V::zero(),
+            slot: 0,
+            is_wall: false,
+        };
+        self.sorted.clear();
+        self.sorted.resize(m, filler);
+        self.sorted_keys.clear();
+        self.sorted_keys.resize(m, 0);
+        self.sorted_coords.clear();
+        self.sorted_coords.resize(m, [0; 3]);
+        // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
+        // the shift below turns ends back into starts.
+        for (j, &i) in self.members.iter().enumerate() {
+            let k = self.keys[j] as usize;
+            let at = self.start[k] as usize;
+            self.sorted[at] = objs[i as usize];
+            self.sorted_keys[at] = k as u32;
+            self.sorted_coords[at] = self.coords[j];
+            self.start[k] += 1;
+        }
+        for k in (1..=ncells).rev() {
+            self.start[k] = self.start[k - 1];
+        }
+        self.start[0] = 0;
+        cell
+    }
+}
+
+/// The skin of the Verlet list, as a fraction of the smallest object's width.
+const SKIN: f64 = 0.4;
+
+/// The kept pairs of the Verlet list and the objects as they were when it was built.
+struct PairList<V> {
+    valid: bool,
+    skin: f64,
+    refs: Vec<BroadObject<V>>,
+    pairs: Vec<(u32, u32)>,
+    scratch: Vec<BroadObject<V>>,
+    rebuilds: u64,
+}
+
+impl<V> Default for PairList<V> {
+    fn default() -> Self {
+        PairList {
+            valid: false,
+            skin: 0.0,
+            refs: Vec::new(),
+            pairs: Vec::new(),
+            scratch: Vec::new(),
+            rebuilds: 0,
+        }
+    }
 }
 
 /// The broad phase, with its scratch memory kept between steps.
-#[derive(Default)]
-pub struct BroadPhase {
+pub struct BroadPhase<V> {
     /// Algorithm choice.
     pub mode: BroadPhaseMode,
-    levels: Vec<Level>,
+    list: PairList<V>,
+    levels: Vec<Level<V>>,
     level_of: Vec<u8>,
     /// Number of bounding-box tests made in the last call.
     pub tests: u64,
     /// Number of grid levels used in the last call (0 for the direct loop).
     pub levels_used: usize,
+}
+
+impl<V> Default for BroadPhase<V> {
+    fn default() -> Self {
+        BroadPhase {
+            mode: BroadPhaseMode::Auto,
+            list: PairList::default(),
+            levels: Vec::new(),
+            level_of: Vec::new(),
+            tests: 0,
+            levels_used: 0,
+        }
+    }
 }
 
 #[inline]
@@ -254,7 +395,7 @@ fn overlaps<V: Vector>(topo: &Topology<V>, a: &BroadObject<V>, b: &BroadObject<V
     true
 }
 
-impl BroadPhase {
+impl<V: Vector> BroadPhase<V> {
     /// A broad phase using `mode`.
     pub fn new(mode: BroadPhaseMode) -> Self {
         BroadPhase {
@@ -265,7 +406,7 @@ impl BroadPhase {
 
     /// Fills `out` with every pair of objects whose bounding boxes overlap, each pair once, as
     /// `(slot, slot)`. Deterministic: the order depends only on `objs`.
-    pub fn find_pairs<V: Vector>(
+    pub fn find_pairs(
         &mut self,
         objs: &[BroadObject<V>],
         topo: &Topology<V>,
@@ -281,12 +422,83 @@ impl BroadPhase {
         if direct || objs.is_empty() {
             self.levels_used = 0;
             self.all_pairs(objs, topo, out);
-        } else {
+        } else if self.mode == BroadPhaseMode::Grid {
             self.grid(objs, topo, out);
+        } else {
+            self.listed_pairs(objs, topo, out);
         }
     }
 
-    fn all_pairs<V: Vector>(
+    /// Auto mode's pairs for large scenes: a Verlet list. The grid is built with every box
+    /// widened by half a skin, and the pairs it finds are kept; while no object has moved more
+    /// than half the skin from where it was then (and none came, went or changed size), every
+    /// overlapping pair is among them, so a step only re-tests the kept pairs.
+    fn listed_pairs(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        if !self.list_still_valid(objs, topo) {
+            self.rebuild_list(objs, topo);
+        }
+        for &(i, j) in &self.list.pairs {
+            let (a, b) = (&objs[i as usize], &objs[j as usize]);
+            self.tests += 1;
+            if overlaps(topo, a, b) {
+                out.push((a.slot, b.slot));
+            }
+        }
+    }
+
+    fn list_still_valid(&self, objs: &[BroadObject<V>], topo: &Topology<V>) -> bool {
+        let list = &self.list;
+        if !list.valid || list.refs.len() != objs.len() {
+            return false;
+        }
+        let reach = 0.5 * list.skin;
+        objs.iter().zip(&list.refs).all(|(o, r)| {
+            if o.slot != r.slot || o.half != r.half {
+                return false;
+            }
+            let d = topo.delta(r.center, o.center);
+            (0..V::DIM).all(|axis| d.get(axis).abs() <= reach)
+        })
+    }
+
+    fn rebuild_list(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>) {
+        let width =
+            |o: &BroadObject<V>| (0..V::DIM).map(|a| 2.0 * o.half.get(a)).fold(0.0, f64::max);
+        let s0 = objs.iter().map(width).fold(f64::INFINITY, f64::min);
+        let skin = SKIN * s0;
+        // Widened copies, named by their index so the kept pairs index `objs`.
+        let mut widened = std::mem::take(&mut self.list.scratch);
+        widened.clear();
+        widened.extend(objs.iter().enumerate().map(|(i, o)| BroadObject {
+            center: o.center,
+            half: o.half + V::splat(0.5 * skin),
+            slot: i as u32,
+            is_wall: o.is_wall,
+        }));
+        let mut pairs = std::mem::take(&mut self.list.pairs);
+        pairs.clear();
+        self.grid(&widened, topo, &mut pairs);
+        self.list.pairs = pairs;
+        self.list.scratch = widened;
+        self.list.refs.clear();
+        self.list.refs.extend_from_slice(objs);
+        self.list.skin = skin;
+        self.list.valid = true;
+        self.list.rebuilds += 1;
+        self.tests = 0;
+    }
+
+    /// How many times the Verlet list was rebuilt (diagnostics).
+    pub fn rebuilds(&self) -> u64 {
+        self.list.rebuilds
+    }
+
+    fn all_pairs(
         &mut self,
         objs: &[BroadObject<V>],
         topo: &Topology<V>,
@@ -302,12 +514,7 @@ impl BroadPhase {
         }
     }
 
-    fn grid<V: Vector>(
-        &mut self,
-        objs: &[BroadObject<V>],
-        topo: &Topology<V>,
-        out: &mut Vec<(u32, u32)>,
-    ) {
+    fn grid(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
         // Widths, finest width, and each object's level.
         let width = |o: &BroadObject<V>| {
             let mut w: f64 = 0.0;
@@ -346,87 +553,27 @@ impl BroadPhase {
             self.levels[l as usize].members.push(i as u32);
         }
 
-        // Build each non-empty level's grid, finest first, cells never narrower than the level below.
-        let size = topo.size();
+        // Build each non-empty level's grid, finest first, cells never narrower than the level
+        // below. At most ~4 cells per object in the whole scene (not per level: a sparse fine
+        // level must not force coarse cells on the crowded levels above it).
+        let limit = (4 * objs.len()).max(64) as f64;
         let mut floor_cell = 0.0f64;
         let mut used = Vec::new();
         for l in 0..=top {
-            let level = &mut self.levels[l];
-            if level.members.is_empty() {
+            if self.levels[l].members.is_empty() {
                 continue;
             }
             used.push(l);
-            let m = level.members.len();
-            let mut cell = (s0 * (l as f64).exp2()).max(floor_cell);
-            // At most ~4 cells per object in the whole scene (not per level: a sparse fine level
-            // must not force coarse cells on the crowded levels above it).
-            let limit = (4 * objs.len()).max(64) as f64;
-            loop {
-                let mut cells = 1.0;
-                for axis in 0..3 {
-                    level.wrap[axis] = false;
-                    if axis >= V::DIM {
-                        level.dims[axis] = 1;
-                        level.inv_cell[axis] = 0.0;
-                        continue;
-                    }
-                    let len = size.get(axis);
-                    if topo.wraps() {
-                        let mut n = (len / cell).floor().max(1.0) as usize;
-                        if n < 3 {
-                            n = 1;
-                        }
-                        level.dims[axis] = n;
-                        level.wrap[axis] = n > 1;
-                        level.inv_cell[axis] = n as f64 / len;
-                    } else {
-                        let n = (len / cell).ceil().clamp(1.0, 1e9) as usize;
-                        level.dims[axis] = n;
-                        level.inv_cell[axis] = 1.0 / cell;
-                    }
-                    cells *= level.dims[axis] as f64;
-                }
-                if cells <= limit {
-                    break;
-                }
-                cell *= (cells / limit).powf(1.0 / V::DIM as f64) * 1.01;
-            }
-            floor_cell = cell;
-
-            // Counting sort of the members by cell key.
-            let ncells = level.dims[0] * level.dims[1] * level.dims[2];
-            level.start.clear();
-            level.start.resize(ncells + 1, 0);
-            level.keys.clear();
-            for &i in &level.members {
-                let k = level.key(level.coords(topo, objs[i as usize].center));
-                level.keys.push(k as u32);
-                level.start[k + 1] += 1;
-            }
-            for k in 0..ncells {
-                level.start[k + 1] += level.start[k];
-            }
-            level.sorted.clear();
-            level.sorted.resize(m, 0);
-            level.sorted_keys.clear();
-            level.sorted_keys.resize(m, 0);
-            level.fill.clear();
-            level.fill.extend_from_slice(&level.start[..ncells]);
-            for (j, &i) in level.members.iter().enumerate() {
-                let k = level.keys[j] as usize;
-                let at = level.fill[k] as usize;
-                level.sorted[at] = i;
-                level.sorted_keys[at] = k as u32;
-                level.fill[k] += 1;
-            }
+            let cell = (s0 * (l as f64).exp2()).max(floor_cell);
+            floor_cell = self.levels[l].build(objs, topo, cell, limit);
         }
         self.levels_used = used.len();
 
-        // Pairs within each level: own cell, then the forward half of the neighbours. Only
-        // occupied cells are visited, walking the cell-sorted members.
+        // Pairs within each level: own cell, then the forward half of the neighbours, walking
+        // the occupied cells in order.
         for &l in &used {
             let level = &self.levels[l];
-            let forward = level.offsets(V::DIM, true);
+            let forward = level.offsets(true);
             let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
             let m = level.sorted.len();
             let mut begin = 0;
@@ -437,18 +584,16 @@ impl BroadPhase {
                     end += 1;
                 }
                 let here = &level.sorted[begin..end];
+                let c = level.sorted_coords[begin].map(|x| x as usize);
                 begin = end;
-                for (j, &ia) in here.iter().enumerate() {
-                    let a = &objs[ia as usize];
-                    for &ib in &here[j + 1..] {
+                for (j, a) in here.iter().enumerate() {
+                    for b in &here[j + 1..] {
                         self.tests += 1;
-                        let b = &objs[ib as usize];
                         if overlaps(topo, a, b) {
                             out.push((a.slot, b.slot));
                         }
                     }
                 }
-                let c = level.decode(key);
                 let interior = level.interior(c);
                 for (&o, &delta) in forward.iter().zip(&deltas) {
                     let nk = if interior {
@@ -460,11 +605,9 @@ impl BroadPhase {
                         }
                     };
                     let there = level.cell(nk);
-                    for &ia in here {
-                        let a = &objs[ia as usize];
-                        for &ib in there {
+                    for a in here {
+                        for b in there {
                             self.tests += 1;
-                            let b = &objs[ib as usize];
                             if overlaps(topo, a, b) {
                                 out.push((a.slot, b.slot));
                             }
@@ -485,17 +628,16 @@ impl BroadPhase {
                 let by_coarse: f64 = coarse_level
                     .sorted
                     .iter()
-                    .map(|&ib| {
+                    .map(|b| {
                         fine_level
-                            .footprint(topo, &objs[ib as usize])
+                            .footprint(topo, b)
                             .iter()
                             .map(|r| r.1 as f64)
                             .product::<f64>()
                     })
                     .sum();
                 if by_coarse < by_fine {
-                    for &ib in &coarse_level.sorted {
-                        let b = &objs[ib as usize];
+                    for b in &coarse_level.sorted {
                         let ranges = fine_level.footprint(topo, b);
                         for k in 0..ranges[2].1 {
                             for j in 0..ranges[1].1 {
@@ -505,9 +647,8 @@ impl BroadPhase {
                                         fine_level.axis_cell(1, ranges[1].0 + j as i64),
                                         fine_level.axis_cell(2, ranges[2].0 + k as i64),
                                     ];
-                                    for &ia in fine_level.cell(fine_level.key(c)) {
+                                    for a in fine_level.cell(fine_level.key(c)) {
                                         self.tests += 1;
-                                        let a = &objs[ia as usize];
                                         if overlaps(topo, a, b) {
                                             out.push((a.slot, b.slot));
                                         }
@@ -517,17 +658,15 @@ impl BroadPhase {
                         }
                     }
                 } else {
-                    let all = coarse_level.offsets(V::DIM, false);
-                    for &ia in &fine_level.sorted {
-                        let a = &objs[ia as usize];
+                    let all = coarse_level.offsets(false);
+                    for a in &fine_level.sorted {
                         let c = coarse_level.coords(topo, a.center);
                         for &o in &all {
                             let Some(nk) = coarse_level.neighbour(c, o) else {
                                 continue;
                             };
-                            for &ib in coarse_level.cell(nk) {
+                            for b in coarse_level.cell(nk) {
                                 self.tests += 1;
-                                let b = &objs[ib as usize];
                                 if overlaps(topo, a, b) {
                                     out.push((a.slot, b.slot));
                                 }
@@ -658,6 +797,55 @@ mod tests {
                 bp.tests
             );
             assert_eq!(grid(&objs, &topo), brute(&objs, &topo));
+        }
+    }
+
+    #[test]
+    fn verlet_list_finds_what_a_fresh_grid_finds_as_things_move_come_and_go() {
+        let mut rng = Rng::new(3);
+        for border in [Border::Bounce, Border::Wrap] {
+            let topo = Topology {
+                min: DVec2::ZERO,
+                max: DVec2::splat(60.0),
+                border,
+            };
+            let mut objs = random_objs::<DVec2>(&mut rng, 1200, 50.0, 0.4, 0.6);
+            objs.push(BroadObject {
+                center: DVec2::new(30.0, 0.0),
+                half: DVec2::new(30.0, 0.3),
+                slot: 9999,
+                is_wall: true,
+            });
+            let mut auto = BroadPhase::new(BroadPhaseMode::Auto);
+            for step in 0..40 {
+                let mut listed = Vec::new();
+                auto.find_pairs(&objs, &topo, &mut listed);
+                let n = listed.len();
+                let listed = normalise(listed);
+                let mut dedup = listed.clone();
+                dedup.dedup();
+                assert_eq!(dedup.len(), n, "step {step}: a pair listed twice");
+                assert_eq!(listed, brute(&objs, &topo), "step {step}");
+                // Drift, with now and then a jump, a death and a birth.
+                for o in objs.iter_mut().filter(|o| !o.is_wall) {
+                    o.center += DVec2::new(rng.uniform(-0.04, 0.04), rng.uniform(-0.04, 0.04));
+                }
+                if step % 17 == 5 {
+                    objs[7].center = DVec2::new(rng.uniform(0.0, 60.0), rng.uniform(0.0, 60.0));
+                }
+                if step % 23 == 11 {
+                    let gone = objs.remove(3);
+                    objs.push(BroadObject {
+                        slot: 20_000 + step,
+                        ..gone
+                    });
+                }
+            }
+            assert!(
+                auto.rebuilds() < 40,
+                "the list should last several steps: {} rebuilds",
+                auto.rebuilds()
+            );
         }
     }
 

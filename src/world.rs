@@ -200,7 +200,7 @@ pub struct World<V: Vector> {
     critters: CritterSet<V>,
     kinds: KindSet<V>,
     rules: RuleCache,
-    broad: BroadPhase,
+    broad: BroadPhase<V>,
     walls: Vec<CritterId>,
     rng: Rng,
     step_count: u64,
