@@ -442,12 +442,25 @@ impl<V: Vector> BroadPhase<V> {
         if !self.list_still_valid(objs, topo) {
             self.rebuild_list(objs, topo);
         }
-        for &(i, j) in &self.list.pairs {
+        let test = |&(i, j): &(u32, u32)| {
             let (a, b) = (&objs[i as usize], &objs[j as usize]);
-            self.tests += 1;
-            if overlaps(topo, a, b) {
-                out.push((a.slot, b.slot));
+            overlaps(topo, a, b).then_some((a.slot, b.slot))
+        };
+        self.tests += self.list.pairs.len() as u64;
+        if objs.len() >= crate::world::PARALLEL_MIN {
+            // Chunks are tested in parallel and joined in order: the same output for any thread count.
+            use rayon::prelude::*;
+            let parts: Vec<Vec<(u32, u32)>> = self
+                .list
+                .pairs
+                .par_chunks(4096)
+                .map(|chunk| chunk.iter().filter_map(test).collect())
+                .collect();
+            for part in parts {
+                out.extend(part);
             }
+        } else {
+            out.extend(self.list.pairs.iter().filter_map(test));
         }
     }
 
@@ -457,13 +470,19 @@ impl<V: Vector> BroadPhase<V> {
             return false;
         }
         let reach = 0.5 * list.skin;
-        objs.iter().zip(&list.refs).all(|(o, r)| {
+        let unmoved = |(o, r): (&BroadObject<V>, &BroadObject<V>)| {
             if o.slot != r.slot || o.half != r.half {
                 return false;
             }
             let d = topo.delta(r.center, o.center);
             (0..V::DIM).all(|axis| d.get(axis).abs() <= reach)
-        })
+        };
+        if objs.len() >= crate::world::PARALLEL_MIN {
+            use rayon::prelude::*;
+            objs.par_iter().zip(&list.refs).all(unmoved)
+        } else {
+            objs.iter().zip(&list.refs).all(unmoved)
+        }
     }
 
     fn rebuild_list(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>) {

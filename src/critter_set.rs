@@ -134,6 +134,20 @@ impl<V: Vector> CritterSet<V> {
         self.slots.iter().filter_map(Option::as_ref)
     }
 
+    /// The critters, in slot order, in parallel (each is visited by one thread).
+    pub fn par_iter_mut(&mut self) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
+        use rayon::prelude::*;
+        self.slots.par_iter_mut().filter_map(Option::as_mut)
+    }
+
+    /// The slots, in order, in parallel.
+    pub fn par_slots(
+        &self,
+    ) -> impl rayon::iter::IndexedParallelIterator<Item = &Option<Critter<V>>> {
+        use rayon::prelude::*;
+        self.slots.par_iter()
+    }
+
     /// The critters, in slot order, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.slots.iter_mut().filter_map(Option::as_mut)

@@ -34,6 +34,10 @@ use std::collections::BTreeMap;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
+/// Worlds with at least this many critters run the stages that allow it on all cores (the
+/// results do not depend on the number of threads).
+pub const PARALLEL_MIN: usize = 20_000;
+
 /// The settings a world is made with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorldConfig<V: Vector> {
@@ -698,9 +702,10 @@ impl<V: Vector> World<V> {
     fn stage_move(&mut self) {
         let (dt, g, topo) = (self.dt, self.gravity, self.topo);
         let dv = g * dt;
-        for c in self.critters.iter_mut() {
+        // Each critter moves on its own, so any split over threads gives the same bits.
+        let step = |c: &mut Critter<V>| {
             if !c.alive || c.is_wall() {
-                continue;
+                return;
             }
             if !c.fixed {
                 c.vel += dv;
@@ -709,33 +714,64 @@ impl<V: Vector> World<V> {
             let (pos, vel) = topo.apply(moved, c.vel, c.radius, c.restitution);
             c.pos = pos;
             c.vel = vel;
+        };
+        if self.critters.len() >= PARALLEL_MIN {
+            use rayon::prelude::*;
+            self.critters.par_iter_mut().for_each(step);
+        } else {
+            self.critters.iter_mut().for_each(step);
         }
     }
 
     fn stage_broad_phase(&mut self) {
-        self.objs.clear();
-        let mut largest_radius: f64 = 0.0;
-        for c in self.critters.iter_mut() {
-            if !c.alive {
-                continue;
-            }
-            if c.class == CLASS_UNSET {
+        // New critters and changed priorities need their rule class (rare; sequential).
+        let unset = |c: &Critter<V>| c.alive && c.class == CLASS_UNSET;
+        let any_unset = if self.critters.len() >= PARALLEL_MIN {
+            use rayon::prelude::*;
+            self.critters
+                .par_slots()
+                .any(|s| s.as_ref().is_some_and(unset))
+        } else {
+            self.critters.iter().any(unset)
+        };
+        if any_unset {
+            for c in self.critters.iter_mut().filter(|c| unset(c)) {
                 c.class = self.rules.class_of(&self.kinds, c);
             }
+        }
+        let object = |c: &Critter<V>| -> Option<BroadObject<V>> {
+            if !c.alive {
+                return None;
+            }
             let (half, is_wall) = match &c.shape {
-                Shape::Disk => {
-                    largest_radius = largest_radius.max(c.radius);
-                    (V::splat(c.radius), false)
-                }
+                Shape::Disk => (V::splat(c.radius), false),
                 Shape::Wall(w) => (w.aabb_half(), true),
             };
-            self.objs.push(BroadObject {
+            Some(BroadObject {
                 center: c.pos,
                 half,
                 slot: c.id.index,
                 is_wall,
-            });
+            })
+        };
+        if self.critters.len() >= PARALLEL_MIN {
+            use rayon::prelude::*;
+            self.objs.clear();
+            self.objs.par_extend(
+                self.critters
+                    .par_slots()
+                    .filter_map(|s| s.as_ref().and_then(object)),
+            );
+        } else {
+            self.objs.clear();
+            self.objs.extend(self.critters.iter().filter_map(object));
         }
+        let largest_radius = self
+            .objs
+            .iter()
+            .filter(|o| !o.is_wall)
+            .map(|o| o.half.get(0))
+            .fold(0.0, f64::max);
         // Wall pairs are tested after the disk pairs have been separated (see the response), and
         // a separation moves a disk by at most about its radius: widen walls' boxes by that much.
         if !self.walls.is_empty() {

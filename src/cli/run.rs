@@ -258,6 +258,14 @@ fn stats(out: &mut dyn Write, world: &AnyWorld, steps: u64) -> anyhow::Result<()
     ] {
         writeln!(out, "  {stage:<12} {:.4}", per(d))?;
     }
+    if let Some(peak) = peak_rss_bytes() {
+        writeln!(
+            out,
+            "memory       peak {:.1} MiB ({:.0} bytes per critter, whole process)",
+            peak as f64 / (1 << 20) as f64,
+            peak as f64 / world.len().max(1) as f64
+        )?;
+    }
     writeln!(
         out,
         "pairs/step   {:.1} box tests, {:.1} candidates, {:.1} may collide, {:.1} touching",
@@ -267,4 +275,12 @@ fn stats(out: &mut dyn Write, world: &AnyWorld, steps: u64) -> anyhow::Result<()
         t.contacts as f64 / n
     )?;
     Ok(())
+}
+
+/// The process's peak resident memory, where the system says it (Linux).
+fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
