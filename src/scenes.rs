@@ -89,6 +89,10 @@ impl AnyWorld {
     pub fn border(&self) -> Border {
         both!(self, w => w.topology().border)
     }
+    /// How many times the broad phase rebuilt its Verlet list.
+    pub fn broad_phase_rebuilds(&self) -> u64 {
+        both!(self, w => w.broad_phase_rebuilds())
+    }
     /// Changes the time step.
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         both!(self, w => w.set_dt(dt))

@@ -331,6 +331,10 @@ impl<V: Vector> World<V> {
     pub fn contact_pairs(&self) -> &[(u32, u32)] {
         &self.contacts
     }
+    /// How many times the broad phase rebuilt its Verlet list (diagnostics).
+    pub fn broad_phase_rebuilds(&self) -> u64 {
+        self.broad.rebuilds()
+    }
     /// The class-pair rule table (diagnostics: how often roles were computed from hooks).
     pub fn rule_cache(&self) -> &RuleCache {
         &self.rules

@@ -258,6 +258,14 @@ fn stats(out: &mut dyn Write, world: &AnyWorld, steps: u64) -> anyhow::Result<()
     ] {
         writeln!(out, "  {stage:<12} {:.4}", per(d))?;
     }
+    let rebuilds = world.broad_phase_rebuilds();
+    if rebuilds > 0 {
+        writeln!(
+            out,
+            "pair list    rebuilt {rebuilds} times (every {:.1} steps)",
+            steps as f64 / rebuilds as f64
+        )?;
+    }
     if let Some(peak) = peak_rss_bytes() {
         writeln!(
             out,
