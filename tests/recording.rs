@@ -538,6 +538,17 @@ fn commands_inspect_diff_export_and_their_exit_codes() {
         assert!(out.contains(line), "{line} missing:\n{out}");
     }
 
+    for chart in ["chart.svg", "chart.png"] {
+        let o = critterbox(&["inspect", &s(&a), "--plot", &s(&dir.join(chart))]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert!(
+            std::fs::metadata(dir.join(chart)).map_or(0, |m| m.len()) > 1000,
+            "{chart}"
+        );
+    }
+    let svg = std::fs::read_to_string(dir.join("chart.svg")).expect("svg");
+    assert!(svg.contains("<svg") && svg.contains("kinetic energy"));
+
     let o = critterbox(&["diff", &s(&a), &s(&b)]);
     assert!(
         o.status.success(),
