@@ -1,8 +1,8 @@
 //! The per-step state hash: a fast 64-bit hash over raw float bits, so a replay can check itself.
 //!
-//! Recording hashes every step, so the hash must cost little next to a step: four independent
-//! multiply-xor lanes take four words at a time (the multiplies of one group overlap instead of
-//! waiting on each other), and the lanes are combined at the end. Each lane update
+//! Recording hashes every step, so the hash must cost little next to a step: eight independent
+//! multiply-xor lanes take eight words at a time (one critter), so the multiplies overlap instead
+//! of waiting on each other, and the lanes are combined at the end. Each lane update
 //! `(h.rotate_left(5) ^ w) * K` is a bijection of `h` for a fixed `w` and of `w` for a fixed `h`,
 //! so a change in any one word always changes that lane's state.
 
@@ -12,8 +12,11 @@ const K: u64 = 0x5851_F42D_4C95_7F2D;
 /// Hashes 64-bit words. Not cryptographic: it exists to notice that two runs differ.
 #[derive(Clone, Debug)]
 pub struct StateHasher {
-    lanes: [u64; 4],
+    lanes: [u64; LANES],
 }
+
+/// Number of lanes, and words per [`StateHasher::words`] call.
+pub const LANES: usize = 8;
 
 impl Default for StateHasher {
     fn default() -> Self {
@@ -23,6 +26,10 @@ impl Default for StateHasher {
                 0x9E37_79B9_7F4A_7C15,
                 0xBF58_476D_1CE4_E5B9,
                 0x94D0_49BB_1331_11EB,
+                0xA076_1D64_78BD_642F,
+                0xE703_7ED1_A0B4_28DB,
+                0x8EBC_6AF0_9C88_C6E3,
+                0x5899_65CC_7537_4CC3,
             ],
         }
     }
@@ -35,9 +42,9 @@ impl StateHasher {
         self.lanes[0] = mix(self.lanes[0], w);
     }
 
-    /// Adds four words, one to each lane: the fast path for bulk state.
+    /// Adds eight words, one to each lane: the fast path for bulk state.
     #[inline]
-    pub fn words(&mut self, w: [u64; 4]) {
+    pub fn words(&mut self, w: [u64; LANES]) {
         for (lane, w) in self.lanes.iter_mut().zip(w) {
             *lane = mix(*lane, w);
         }
@@ -93,15 +100,15 @@ mod tests {
 
     #[test]
     fn every_bit_of_every_lane_counts() {
-        let base = [1u64, 2, 3, 4];
-        let hash = |w: [u64; 4]| {
+        let base = [1u64, 2, 3, 4, 5, 6, 7, 8];
+        let hash = |w: [u64; LANES]| {
             let mut h = StateHasher::default();
             h.words(w);
             h.words(base);
             h.finish()
         };
         let h0 = hash(base);
-        for lane in 0..4 {
+        for lane in 0..LANES {
             for bit in 0..64 {
                 let mut w = base;
                 w[lane] ^= 1 << bit;

@@ -396,8 +396,6 @@ impl<V: Vector> World<V> {
                 flags ^ (c.props.len() as u64).rotate_left(40),
                 pair(c.pos.get(0), c.pos.get(1)),
                 pair(c.vel.get(0), c.vel.get(1)),
-            ]);
-            h.words([
                 pair(c.radius, c.mass),
                 pair(c.priority, c.restitution),
                 pair(c.health, z),

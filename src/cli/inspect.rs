@@ -25,17 +25,23 @@ pub fn run(args: &InspectArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let rec = Recording::open(&args.file)?;
     summary_head(&rec, out)?;
     let (first, last) = (rec.totals.first(), rec.totals.last());
-    let kinds = |t: Option<&crate::recording::schema::TotalsMsg>| {
-        t.map_or("-".to_string(), |t| {
-            t.by_kind
-                .iter()
-                .map(|(k, n)| format!("{k} {n}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+    let kinds = |c: Option<(&u64, &std::collections::BTreeMap<String, u64>)>| {
+        c.map_or("-".to_string(), |(step, c)| {
+            let list: Vec<String> = c.iter().map(|(k, n)| format!("{k} {n}")).collect();
+            format!("{} (step {step})", list.join(", "))
         })
     };
-    writeln!(out, "critters     at start: {}", kinds(first))?;
-    writeln!(out, "             at end:   {}", kinds(last))?;
+    let counts = &rec.kind_counts;
+    writeln!(
+        out,
+        "critters     at start: {}",
+        kinds(counts.iter().next())
+    )?;
+    writeln!(
+        out,
+        "             at end:   {}",
+        kinds(counts.iter().next_back())
+    )?;
     let collisions: u64 = rec.totals.iter().map(|t| t.collisions).sum();
     let impacts: u64 = rec.totals.iter().map(|t| t.impacts).sum();
     let spawns: usize = rec.lifecycle.iter().map(|l| l.spawn.len()).sum();

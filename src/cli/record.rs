@@ -23,7 +23,8 @@ pub struct RecordArgs {
     #[arg(long, conflicts_with = "record", help_heading = "Recording")]
     pub no_record: bool,
     /// Record the full state every K steps (1 = every step). Hash, totals and events are recorded
-    /// every step anyway. Default: every step for scenes of up to 100 critters, else every 60.
+    /// every step anyway. Default: every step for scenes of up to 100 critters, else a K chosen to
+    /// keep recording under 10% of the step time (see docs/recording-format.md).
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..), help_heading = "Recording")]
     pub record_every: Option<u64>,
 }

@@ -57,41 +57,24 @@ pub fn kind_table<V: Vector>(world: &World<V>) -> KindTable {
     t
 }
 
-/// Hash and totals in one pass; `counts` is scratch space for the counts by kind.
-pub fn hash_and_totals<V: Vector>(world: &World<V>, counts: &mut Vec<u64>) -> (u64, TotalsMsg) {
-    let kinds = world.kinds();
-    counts.clear();
-    counts.resize(kinds.len(), 0);
+/// Hash and totals in one pass over the critters.
+pub fn hash_and_totals<V: Vector>(world: &World<V>) -> (u64, TotalsMsg) {
     let mut energy = 0.0;
     let mut momentum = V::zero();
-    let mut live = 0u64;
     let hash = world.state_hash_visiting(|c| {
         // The same sums, in the same order, as World::kinetic_energy and World::momentum.
         energy += c.kinetic_energy();
         if !c.is_fixed() {
             momentum += c.vel * c.mass();
         }
-        if c.is_alive() {
-            live += 1;
-            if let Some(n) = counts.get_mut(c.kind().0 as usize) {
-                *n += 1;
-            }
-        }
     });
-    let by_kind: BTreeMap<String, u64> = counts
-        .iter()
-        .enumerate()
-        .filter(|(_, &n)| n > 0)
-        .map(|(k, &n)| (kinds.name(crate::kind::KindId(k as u32)).to_string(), n))
-        .collect();
     let stats = world.stats();
     let totals = TotalsMsg {
         step: world.step_count(),
         time: Float(world.time()),
         kinetic_energy: Float(energy),
         momentum: Floats((0..V::DIM).map(|a| momentum.get(a)).collect()),
-        critters: live,
-        by_kind,
+        critters: world.critters().len() as u64,
         collisions: stats.collisions as u64,
         impacts: stats.impacts as u64,
         contacts: stats.contacts as u64,
@@ -218,25 +201,15 @@ pub fn events<V: Vector>(
 
 /// Captures a step of `world`: always hash, totals and events; the full state when `full`; the
 /// kind table when its size is not `known_kinds`.
-pub fn capture(
-    world: &AnyWorld,
-    full: bool,
-    known_kinds: usize,
-    counts: &mut Vec<u64>,
-) -> StepRecord {
+pub fn capture(world: &AnyWorld, full: bool, known_kinds: usize) -> StepRecord {
     match world {
-        AnyWorld::D2(w) => capture_world(w, full, known_kinds, counts),
-        AnyWorld::D3(w) => capture_world(w, full, known_kinds, counts),
+        AnyWorld::D2(w) => capture_world(w, full, known_kinds),
+        AnyWorld::D3(w) => capture_world(w, full, known_kinds),
     }
 }
 
-fn capture_world<V: Vector>(
-    world: &World<V>,
-    full: bool,
-    known_kinds: usize,
-    counts: &mut Vec<u64>,
-) -> StepRecord {
-    let (hash, totals) = hash_and_totals(world, counts);
+fn capture_world<V: Vector>(world: &World<V>, full: bool, known_kinds: usize) -> StepRecord {
+    let (hash, totals) = hash_and_totals(world);
     let (collisions, lifecycle, log) = events(world);
     StepRecord {
         step: world.step_count(),
@@ -261,10 +234,9 @@ pub fn any_state(world: &AnyWorld) -> StateMsg {
 
 /// Hash and totals of any world.
 pub fn any_hash_and_totals(world: &AnyWorld) -> (u64, TotalsMsg) {
-    let mut counts = Vec::new();
     match world {
-        AnyWorld::D2(w) => hash_and_totals(w, &mut counts),
-        AnyWorld::D3(w) => hash_and_totals(w, &mut counts),
+        AnyWorld::D2(w) => hash_and_totals(w),
+        AnyWorld::D3(w) => hash_and_totals(w),
     }
 }
 

@@ -125,6 +125,37 @@ impl RunMeta {
         m
     }
 
+    /// The metadata of a built-in scene built with `params` (for programs and benchmarks that
+    /// record without the command line).
+    pub fn builtin(
+        scene: &crate::scenes::Scene,
+        params: &crate::scenes::SceneParams,
+        steps: u64,
+        record_every: u64,
+    ) -> RunMeta {
+        let w = &scene.world;
+        RunMeta {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.name.clone(),
+            source: SceneSource::Builtin,
+            seed: params.seed,
+            seed_override: Some(params.seed),
+            dt: w.dt(),
+            dt_override: params.dt,
+            steps,
+            method: "discrete".into(),
+            dim: w.dim(),
+            border: format!("{:?}", w.border()).to_lowercase(),
+            n: params.n,
+            sets: Vec::new(),
+            limits: Limits::default(),
+            command_line: Vec::new(),
+            record_every,
+            critters: w.len(),
+            created: utc_now().1,
+        }
+    }
+
     /// From an MCAP metadata map; errors name the missing or bad key.
     pub fn from_map(m: &BTreeMap<String, String>) -> Result<RunMeta, String> {
         let get = |k: &str| {

@@ -276,6 +276,8 @@ pub struct Recording {
     pub totals: Vec<TotalsMsg>,
     /// Steps with a full state.
     pub keyframes: Vec<u64>,
+    /// Critters by kind in each full state, by step.
+    pub kind_counts: BTreeMap<u64, BTreeMap<String, u64>>,
     /// Collisions per step (steps with any).
     pub collisions: BTreeMap<u64, usize>,
     /// Lifecycle events.
@@ -372,11 +374,19 @@ impl Recording {
             schema::TOTALS => self.totals.push(decode(topic, data)?),
             schema::STATE => {
                 #[derive(serde::Deserialize)]
-                struct Step {
+                struct Kinds {
                     step: u64,
+                    kinds: Vec<String>,
+                    kind: Vec<u32>,
                 }
-                let s: Step = decode(topic, data)?;
+                let s: Kinds = decode(topic, data)?;
+                let mut counts = BTreeMap::new();
+                for k in s.kind {
+                    let name = s.kinds.get(k as usize).map_or("?", String::as_str);
+                    *counts.entry(name.to_string()).or_insert(0) += 1;
+                }
                 self.keyframes.push(s.step);
+                self.kind_counts.insert(s.step, counts);
             }
             schema::COLLISIONS => {
                 #[derive(serde::Deserialize)]

@@ -353,10 +353,8 @@ pub struct TotalsMsg {
     pub kinetic_energy: Float,
     /// Momentum of the free critters (2 or 3 components).
     pub momentum: Floats,
-    /// Live critters (walls included).
+    /// Critters in the world (walls included; the dead are removed at the end of each step).
     pub critters: u64,
-    /// Live critters by kind name.
-    pub by_kind: BTreeMap<String, u64>,
     /// `collide` calls that returned true in the step (resting contacts included).
     pub collisions: u64,
     /// Default collisions that exchanged an impulse.
@@ -548,8 +546,7 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
         step_props(json!({
             "kinetic_energy": float_schema(),
             "momentum": floats_schema("momentum of the free critters (2 or 3 components)"),
-            "critters": { "type": "integer", "minimum": 0, "description": "live critters, walls included" },
-            "by_kind": { "type": "object", "additionalProperties": { "type": "integer" } },
+            "critters": { "type": "integer", "minimum": 0, "description": "critters in the world, walls included" },
             "collisions": { "type": "integer", "minimum": 0, "description": "collide calls that returned true" },
             "impacts": { "type": "integer", "minimum": 0, "description": "default collisions with an impulse" },
             "contacts": { "type": "integer", "minimum": 0, "description": "touching pairs" },

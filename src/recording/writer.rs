@@ -26,8 +26,12 @@ use std::time::{Duration, Instant};
 /// How often the writer ends the current chunk (wall time).
 pub const FLUSH_EVERY: Duration = Duration::from_millis(250);
 
-/// Steps the simulation may run ahead of the writer.
-const QUEUE: usize = 32;
+/// Batches of steps the simulation may run ahead of the writer.
+const QUEUE: usize = 8;
+
+/// Steps sent to the writer together (one wake-up of its thread per batch, not per step); a
+/// full state goes at once.
+const BATCH: usize = 16;
 
 /// zstd level of the chunks (see docs/recording-format.md for the measurements).
 const ZSTD_LEVEL: u32 = 1;
@@ -46,7 +50,7 @@ pub enum RecordError {
 }
 
 enum Job {
-    Step(Box<StepRecord>),
+    Steps(Vec<StepRecord>),
     State(Box<StateMsg>),
     Error(ErrorMsg),
     Attach(Vec<SourceFile>),
@@ -75,9 +79,9 @@ pub struct Recorder {
     path: PathBuf,
     every: u64,
     known_kinds: usize,
-    counts: Vec<u64>,
     last_step: u64,
     last_state: u64,
+    batch: Vec<StepRecord>,
 }
 
 fn write_err(path: &Path, e: impl std::fmt::Display) -> RecordError {
@@ -161,9 +165,9 @@ impl Recorder {
             path: path.to_path_buf(),
             every: meta.record_every.max(1),
             known_kinds: 0,
-            counts: Vec::new(),
             last_step: 0,
             last_state: 0,
+            batch: Vec::with_capacity(BATCH),
         };
         rec.capture(world, true)?;
         Ok(rec)
@@ -181,7 +185,7 @@ impl Recorder {
     }
 
     fn capture(&mut self, world: &AnyWorld, full: bool) -> Result<(), RecordError> {
-        let rec = capture::capture(world, full, self.known_kinds, &mut self.counts);
+        let rec = capture::capture(world, full, self.known_kinds);
         if let Some(k) = &rec.kinds {
             self.known_kinds = k.names.len();
         }
@@ -189,10 +193,28 @@ impl Recorder {
         if full {
             self.last_state = rec.step;
         }
-        self.send(Job::Step(Box::new(rec)))
+        self.batch.push(rec);
+        if full || self.batch.len() >= BATCH {
+            self.send_batch()?;
+        }
+        Ok(())
     }
 
+    fn send_batch(&mut self) -> Result<(), RecordError> {
+        if self.batch.is_empty() {
+            return Ok(());
+        }
+        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        self.send_now(Job::Steps(batch))
+    }
+
+    /// Sends `job` after the steps still batched.
     fn send(&mut self, job: Job) -> Result<(), RecordError> {
+        self.send_batch()?;
+        self.send_now(job)
+    }
+
+    fn send_now(&mut self, job: Job) -> Result<(), RecordError> {
         let sent = match &self.tx {
             Some(tx) => tx.send(job).is_ok(),
             None => false,
@@ -374,33 +396,39 @@ impl Output {
         Ok(())
     }
 
+    fn write_step(&mut self, rec: StepRecord) -> mcap::McapResult<()> {
+        if let Some(KindTable { colors, .. }) = rec.kinds {
+            self.colors = colors;
+        }
+        let t = self.log_time(rec.time);
+        self.steps = rec.step;
+        let hash = HashMsg {
+            step: rec.step,
+            time: Float(rec.time),
+            hash: format!("{:016x}", rec.hash),
+        };
+        self.put_json(schema::HASH, t, &hash)?;
+        self.put_json(schema::TOTALS, t, &rec.totals)?;
+        if let Some(m) = &rec.collisions {
+            self.put_json(schema::COLLISIONS, t, m)?;
+        }
+        if let Some(m) = &rec.lifecycle {
+            self.put_json(schema::LIFECYCLE, t, m)?;
+        }
+        if let Some(m) = &rec.log {
+            self.put_json(schema::LOG, t, m)?;
+        }
+        if let Some(s) = &rec.state {
+            self.put_state(t, s)?;
+        }
+        Ok(())
+    }
+
     fn write(&mut self, job: Job) -> mcap::McapResult<()> {
         match job {
-            Job::Step(rec) => {
-                let rec = *rec;
-                if let Some(KindTable { colors, .. }) = rec.kinds {
-                    self.colors = colors;
-                }
-                let t = self.log_time(rec.time);
-                self.steps = rec.step;
-                let hash = HashMsg {
-                    step: rec.step,
-                    time: Float(rec.time),
-                    hash: format!("{:016x}", rec.hash),
-                };
-                self.put_json(schema::HASH, t, &hash)?;
-                self.put_json(schema::TOTALS, t, &rec.totals)?;
-                if let Some(m) = &rec.collisions {
-                    self.put_json(schema::COLLISIONS, t, m)?;
-                }
-                if let Some(m) = &rec.lifecycle {
-                    self.put_json(schema::LIFECYCLE, t, m)?;
-                }
-                if let Some(m) = &rec.log {
-                    self.put_json(schema::LOG, t, m)?;
-                }
-                if let Some(s) = &rec.state {
-                    self.put_state(t, s)?;
+            Job::Steps(batch) => {
+                for rec in batch {
+                    self.write_step(rec)?;
                 }
             }
             Job::State(state) => {
