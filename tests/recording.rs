@@ -530,7 +530,7 @@ fn commands_inspect_diff_export_and_their_exit_codes() {
     let out = text(&o);
     for line in [
         "scene        gas",
-        "critters     at start: ball 120, wall 4",
+        "critters     at start: ball 120, wall 4 (step 0)",
         "collisions",
         "over time",
         "kinetic energy",
