@@ -22,17 +22,17 @@ pub struct CostModel {
 
 /// The measured model (see the module docs).
 pub const MEASURED: CostModel = CostModel {
-    step: 80.0,
-    per_step: 6.0,
-    capture: 15.0,
-    encode: 1000.0,
+    step: 95.0,
+    per_step: 8.1,
+    capture: 19.0,
+    encode: 1340.0,
 };
 
 /// Recording may add this fraction to the simulation thread's step time.
 pub const BUDGET: f64 = 0.10;
 
 /// Scenes with at most this many critters record their full state every step: a full state of
-/// 100 critters costs about 0.15 ms on the writer thread and 4 KB in the file.
+/// 100 critters costs about 0.15 ms on the writer thread and 5 KB in the file.
 pub const SMALL_SCENE: usize = 100;
 
 /// The round numbers K is chosen from.
