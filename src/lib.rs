@@ -32,6 +32,7 @@ pub mod critter_set;
 pub mod error;
 pub mod hash;
 pub mod kind;
+pub mod recording;
 pub mod response;
 pub mod rng;
 pub mod rules;

@@ -24,7 +24,7 @@ use crate::critter::{
 };
 use crate::critter_set::CritterSet;
 use crate::error::Error;
-use crate::hash::StateHasher;
+use crate::hash::{pair, StateHasher};
 use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
 use crate::rng::Rng;
 use crate::rules::{PairRule, RuleCache};
@@ -374,8 +374,16 @@ impl<V: Vector> World<V> {
     }
 
     /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
-    /// overwhelming probability) bit-identical worlds.
+    /// overwhelming probability) bit-identical worlds. It covers the step count, dt, the
+    /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
+    /// radius, mass, priority, restitution, health and properties.
     pub fn state_hash(&self) -> u64 {
+        self.state_hash_visiting(|_| {})
+    }
+
+    /// [`World::state_hash`], calling `visit` on each critter (in slot order) in the same pass,
+    /// so a recorder can sum its totals without walking the critters a second time.
+    pub fn state_hash_visiting(&self, mut visit: impl FnMut(&Critter<V>)) -> u64 {
         let mut h = StateHasher::default();
         h.word(self.step_count);
         h.float(self.dt);
@@ -383,17 +391,24 @@ impl<V: Vector> World<V> {
             h.word(w);
         }
         for c in self.critters.iter() {
-            h.word(((c.id.index as u64) << 32) | c.id.generation as u64);
-            h.word(((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64);
-            for axis in 0..V::DIM {
-                h.float(c.pos.get(axis));
-                h.float(c.vel.get(axis));
-            }
-            h.float(c.radius);
-            h.float(c.mass);
-            h.float(c.priority);
-            h.float(c.restitution);
-            h.float(c.health);
+            visit(c);
+            let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
+            let flags = ((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64;
+            let (z, vz) = if V::DIM == 3 {
+                (c.pos.get(2), c.vel.get(2))
+            } else {
+                (0.0, 0.0)
+            };
+            h.words([
+                id,
+                flags ^ (c.props.len() as u64).rotate_left(40),
+                pair(c.pos.get(0), c.pos.get(1)),
+                pair(c.vel.get(0), c.vel.get(1)),
+                pair(c.radius, c.mass),
+                pair(c.priority, c.restitution),
+                pair(c.health, z),
+                vz.to_bits(),
+            ]);
             for (name, value) in &c.props {
                 hash_bytes(&mut h, name.as_bytes());
                 hash_prop(&mut h, value);

@@ -5,6 +5,11 @@ use std::process::{Command, Output};
 fn critterbox(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_critterbox"))
         .args(args)
+        // Runs record by default: keep their recordings out of the source tree.
+        .env(
+            "CRITTERBOX_RECORDINGS",
+            std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-recordings"),
+        )
         .output()
         .expect("the critterbox binary runs")
 }

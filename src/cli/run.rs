@@ -1,5 +1,6 @@
 //! `critterbox run`: run a scene headless and print a summary.
 
+use super::record::{self, RecordArgs};
 use crate::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
 use crate::script::{Limits, ScriptOptions};
 use anyhow::Context;
@@ -53,6 +54,9 @@ pub struct RunArgs {
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
+    /// Recording options.
+    #[command(flatten)]
+    pub recording: RecordArgs,
 }
 
 /// Runs the command.
@@ -84,10 +88,18 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
 
     let energy0 = scene.world.kinetic_energy();
     let momentum0 = scene.world.momentum();
+    // Recording: started before the first step, fed after each one, closed at the end.
+    let mut recorder = record::start(args, &scene, steps)?;
+    record::watch_ctrl_c();
+    let mut interrupted = false;
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
     for i in 0..steps {
+        if record::interrupted() {
+            interrupted = true;
+            break;
+        }
         let step = scene.world.step_count();
         let outcome = scene.step();
         let log = scene.world.log();
@@ -98,7 +110,19 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
                 }
             });
         }
-        if let Some(reason) = outcome.with_context(|| format!("scene '{name}', step {step}"))? {
+        let outcome = match outcome.with_context(|| format!("scene '{name}', step {step}")) {
+            Ok(outcome) => outcome,
+            Err(e) => {
+                // The error goes into the recording, which is closed before it is reported.
+                bar.finish_and_clear();
+                record::fail(recorder.take(), &scene, &e, out)?;
+                return Err(e);
+            }
+        };
+        if let Some(r) = &mut recorder {
+            r.record(&scene.world)?;
+        }
+        if let Some(reason) = outcome {
             stopped = Some((scene.world.step_count(), reason));
             break;
         }
@@ -110,12 +134,22 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let done = scene.world.step_count();
     summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
-    if let Some((at, reason)) = stopped {
+    if let Some((at, reason)) = &stopped {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
     if args.stats {
         stats(out, &scene.world, done)?;
     }
+    let (outcome, reason) = match (&stopped, interrupted) {
+        (_, true) => ("interrupted", "Ctrl-C".to_string()),
+        (Some((_, reason)), _) => ("stopped", reason.clone()),
+        _ => ("completed", String::new()),
+    };
+    record::finish(recorder, &scene, outcome, &reason, out)?;
+    anyhow::ensure!(
+        !interrupted,
+        "interrupted by Ctrl-C after step {done} (the recording is complete up to there)"
+    );
     Ok(())
 }
 
