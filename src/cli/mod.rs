@@ -4,6 +4,7 @@
 
 pub mod check;
 pub mod run;
+pub mod stability;
 pub mod test;
 
 use clap::{Parser, Subcommand};
@@ -26,6 +27,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Run script tests: every `fn test_*()` in scripts/tests/*.rhai.
     Test(test::TestArgs),
+    /// Run the stress scenes under every collision method and print the error table.
+    Stability(stability::StabilityArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
@@ -34,6 +37,7 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         Some(Command::Run(args)) => run::run(&args, out),
         Some(Command::Check(args)) => check::run(&args, out),
         Some(Command::Test(args)) => test::run(&args, out),
+        Some(Command::Stability(args)) => stability::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }
