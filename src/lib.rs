@@ -37,8 +37,8 @@ pub mod response;
 pub mod rng;
 pub mod rules;
 pub mod scenes;
-pub mod stability;
 pub mod script;
+pub mod stability;
 
 pub mod vector;
 pub mod wall;

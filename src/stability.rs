@@ -85,7 +85,7 @@ pub fn bullet(speed: f64, method: Method) -> Result<bool, Error> {
     for _ in 0..steps {
         w.step()?;
         let x = w.get(b).map_or(f64::NAN, |c| c.pos.x);
-        if !(x < wall_x) {
+        if x >= wall_x || x.is_nan() {
             return Ok(true);
         }
     }
@@ -159,7 +159,10 @@ fn floor_box(method: Method) -> Result<World<DVec2>, Error> {
         DVec2::new(-t, -t),
         DVec2::new(10.0 + t, 0.0),
     )?)?;
-    w.add_wall(WallBox::aligned(DVec2::new(-t, 0.0), DVec2::new(0.0, 25.0))?)?;
+    w.add_wall(WallBox::aligned(
+        DVec2::new(-t, 0.0),
+        DVec2::new(0.0, 25.0),
+    )?)?;
     w.add_wall(WallBox::aligned(
         DVec2::new(10.0, 0.0),
         DVec2::new(10.0 + t, 25.0),
@@ -178,11 +181,20 @@ fn resting_pile(method: Method) -> Result<f64, Error> {
                 continue;
             }
             let y = r + 1e-6 + row as f64 * (2.0 * r * 0.866_025_4 + 1e-6);
-            w.spawn(CritterSpec::ball(DVec2::new(x, y)).radius(r).restitution(0.5))?;
+            w.spawn(
+                CritterSpec::ball(DVec2::new(x, y))
+                    .radius(r)
+                    .restitution(0.5),
+            )?;
         }
     }
     let e0 = total_energy(&w);
-    let scale = w.critters().iter().map(|c| c.mass()).filter(|m| m.is_finite()).sum::<f64>()
+    let scale = w
+        .critters()
+        .iter()
+        .map(|c| c.mass())
+        .filter(|m| m.is_finite())
+        .sum::<f64>()
         * 9.81
         * 1.0;
     let mut worst: f64 = 0.0;
@@ -281,11 +293,13 @@ fn collapse_column(method: Method) -> Result<f64, Error> {
     let r = 0.25;
     let mut ids: Vec<CritterId> = Vec::new();
     for k in 0..6 {
-        ids.push(w.spawn(
-            CritterSpec::ball(DVec2::new(5.0, 1.0 + k as f64 * 0.6))
-                .radius(r)
-                .restitution(0.5),
-        )?);
+        ids.push(
+            w.spawn(
+                CritterSpec::ball(DVec2::new(5.0, 1.0 + k as f64 * 0.6))
+                    .radius(r)
+                    .restitution(0.5),
+            )?,
+        );
     }
     let e0 = total_energy(&w);
     let scale = e0.abs().max(1.0);

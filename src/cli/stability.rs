@@ -32,7 +32,10 @@ pub fn run(_args: &StabilityArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         for m in METHODS {
             let t = Instant::now();
             let e = (s.run)(m)?;
-            cells.push(format!("{e:.2e} ({:.0} ms)", t.elapsed().as_secs_f64() * 1e3));
+            cells.push(format!(
+                "{e:.2e} ({:.0} ms)",
+                t.elapsed().as_secs_f64() * 1e3
+            ));
         }
         writeln!(out, "| {} | {} | {} |", s.name, s.error, cells.join(" | "))?;
     }

@@ -92,6 +92,8 @@ pub(crate) struct Scratch<V> {
     cells: Vec<Vec<u32>>,
     cell_walls: Vec<Vec<u32>>,
     heap: BinaryHeap<Reverse<Ev>>,
+    /// Pairs whose hook left them overlapping this step: not handed back at once again.
+    stuck: std::collections::HashSet<u64>,
     dims: [usize; 3],
     side: [f64; 3],
     acc: V,
@@ -153,6 +155,15 @@ fn run_with<V: Vector>(
                 if collide(w, sc, ev.a, ev.b, t)? {
                     stats.collisions += 1;
                 }
+                if let (Some(x), Some(y)) = (w.critters.slot(ev.a), w.critters.slot(ev.b)) {
+                    if x.alive && y.alive {
+                        if let Some(c) = crate::response::contact_between(&w.topo, x, y) {
+                            if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {
+                                sc.stuck.insert(pair_key(ev.a, ev.b));
+                            }
+                        }
+                    }
+                }
                 sc.last[ev.a as usize] = ev.b;
                 sc.last_t[ev.a as usize] = t;
                 if ev.kind == PAIR {
@@ -202,9 +213,11 @@ fn run_with<V: Vector>(
     Ok(complete)
 }
 
+#[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     let n = w.critters.slot_count();
     sc.heap.clear();
+    sc.stuck.clear();
     for v in [&mut sc.count, &mut sc.cell, &mut sc.last] {
         v.clear();
         v.resize(n, NONE);
@@ -301,6 +314,10 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     }
 }
 
+fn pair_key(a: u32, b: u32) -> u64 {
+    ((a.min(b) as u64) << 32) | a.max(b) as u64
+}
+
 fn key(dims: &[usize; 3], c: [i64; 3]) -> usize {
     let m = |i: i64, n: usize| i.rem_euclid(n as i64) as usize;
     m(c[0], dims[0]) + dims[0] * (m(c[1], dims[1]) + dims[1] * m(c[2], dims[2]))
@@ -336,7 +353,11 @@ fn state_at<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, t: f64) -> (V, V, 
     if h == 0.0 {
         return (c.pos, c.vel, acc);
     }
-    (c.pos + c.vel * h + acc * (0.5 * h * h), c.vel + acc * h, acc)
+    (
+        c.pos + c.vel * h + acc * (0.5 * h * h),
+        c.vel + acc * h,
+        acc,
+    )
 }
 
 fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
@@ -403,8 +424,7 @@ fn predict_all<V: Vector>(
         for dy in reach(1) {
             for dx in reach(0) {
                 let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
-                if !w.topo.wraps()
-                    && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
+                if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
                 {
                     continue;
                 }
@@ -515,8 +535,8 @@ fn predict_pair_or_wall<V: Vector>(
         (PAIR, s)
     };
     if let Some(s) = s {
-        if s == 0.0 && just_met {
-            return Ok(()); // the pair was just handled; its hook chose to leave them so
+        if s == 0.0 && (just_met || sc.stuck.contains(&pair_key(a, b))) {
+            return Ok(()); // the pair was handled; its hook chose to leave them so
         }
         if s <= horizon {
             let (x, y) = if kind == PAIR {
@@ -599,7 +619,11 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
     let border = w.topo.border;
     let (lo, hi) = (w.topo.min.get(axis), w.topo.max.get(axis));
     let c = w.critters.slot_mut(a).expect("live slot");
-    let bound = if side == 1 { hi - c.radius } else { lo + c.radius };
+    let bound = if side == 1 {
+        hi - c.radius
+    } else {
+        lo + c.radius
+    };
     c.pos.set(axis, bound);
     let v = c.vel.get(axis);
     let outward = if side == 1 { v > 0.0 } else { v < 0.0 };
@@ -611,6 +635,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
     }
 }
 
+#[allow(clippy::needless_range_loop)]
 fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let (p, v, acc) = state_at(w, sc, a, t);
     let cc = coords(&sc.dims, sc.cell[a as usize] as usize);
@@ -624,7 +649,11 @@ fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
         let hi = lo + sc.side[axis];
         let (x, vx, ax) = (p.get(axis), v.get(axis), acc.get(axis));
         for dir in [0u32, 1] {
-            let at_edge = if dir == 1 { cc[axis] == n - 1 } else { cc[axis] == 0 };
+            let at_edge = if dir == 1 {
+                cc[axis] == n - 1
+            } else {
+                cc[axis] == 0
+            };
             if at_edge && !w.topo.wraps() {
                 continue;
             }
@@ -646,6 +675,7 @@ fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     }
 }
 
+#[allow(clippy::needless_range_loop)]
 fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32, t: f64) {
     advance(w, sc, a, t);
     let (axis, dir) = ((tag / 2) as usize, tag % 2);
