@@ -92,6 +92,8 @@ pub(crate) struct Scratch<V> {
     cells: Vec<Vec<u32>>,
     cell_walls: Vec<Vec<u32>>,
     heap: BinaryHeap<Reverse<Ev>>,
+    /// The earliest event found so far by the running `predict_all`.
+    cand: Option<Ev>,
     /// Pairs whose hook left them overlapping this step: not handed back at once again.
     stuck: std::collections::HashSet<u64>,
     dims: [usize; 3],
@@ -100,6 +102,8 @@ pub(crate) struct Scratch<V> {
     t_end: f64,
     tc: f64,
     budget: u64,
+    predictions: u64,
+    pair_tests: u64,
     /// Sum over default collisions of contact distance x impulse (the collision virial).
     pub virial: f64,
 }
@@ -130,7 +134,7 @@ fn run_with<V: Vector>(
     setup(w, sc, acc, t_end);
     let n = w.critters.slot_count() as u32;
     for a in 0..n {
-        predict_all(w, sc, a, 0.0, true)?;
+        predict_all(w, sc, a, 0.0)?;
     }
     let mut processed = 0u64;
     let mut complete = true;
@@ -138,8 +142,13 @@ fn run_with<V: Vector>(
         if ev.time > t_end {
             break;
         }
-        if !valid(w, sc, &ev) {
-            continue;
+        match validity(w, sc, &ev) {
+            Validity::Stale => continue,
+            Validity::PartnerChanged => {
+                predict_all(w, sc, ev.a, ev.time)?;
+                continue;
+            }
+            Validity::Valid => {}
         }
         processed += 1;
         if processed > sc.budget {
@@ -174,7 +183,7 @@ fn run_with<V: Vector>(
                     if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
                         sc.count[x as usize] = sc.count[x as usize].wrapping_add(1);
                         relocate(w, sc, x);
-                        predict_all(w, sc, x, t, false)?;
+                        predict_all(w, sc, x, t)?;
                     }
                 }
             }
@@ -183,19 +192,21 @@ fn run_with<V: Vector>(
                 bounce_border(w, ev.a, ev.b);
                 sc.last[ev.a as usize] = BORDER_TAG + ev.b;
                 sc.count[ev.a as usize] = sc.count[ev.a as usize].wrapping_add(1);
-                predict_all(w, sc, ev.a, t, false)?;
+                predict_all(w, sc, ev.a, t)?;
             }
             CELL => {
                 cross_cell(w, sc, ev.a, ev.b, t);
-                predict_all(w, sc, ev.a, t, false)?;
+                predict_all(w, sc, ev.a, t)?;
             }
             _ => {
                 // RECHECK: continue a curved prediction that did not settle.
-                predict_pair_or_wall(w, sc, ev.a, ev.b, t)?;
+                predict_all(w, sc, ev.a, t)?;
             }
         }
     }
     stats.events += processed.min(sc.budget);
+    stats.pair_tests += sc.pair_tests;
+    stats.candidates += sc.predictions as usize;
     // Everyone to the end of the flight.
     let topo = w.topo;
     for a in 0..n {
@@ -231,6 +242,8 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     sc.t_end = t_end;
     sc.tc = TC_FRACTION * w.dt;
     sc.virial = 0.0;
+    sc.predictions = 0;
+    sc.pair_tests = 0;
     let mut rmax: f64 = 0.0;
     let mut disks = 0usize;
     for c in w.critters.iter_mut() {
@@ -318,8 +331,18 @@ fn pair_key(a: u32, b: u32) -> u64 {
     ((a.min(b) as u64) << 32) | a.max(b) as u64
 }
 
+#[inline]
 fn key(dims: &[usize; 3], c: [i64; 3]) -> usize {
-    let m = |i: i64, n: usize| i.rem_euclid(n as i64) as usize;
+    let m = |i: i64, n: usize| {
+        let n = n as i64;
+        (if i < 0 {
+            i + n
+        } else if i >= n {
+            i - n
+        } else {
+            i
+        }) as usize
+    };
     m(c[0], dims[0]) + dims[0] * (m(c[1], dims[1]) + dims[1] * m(c[2], dims[2]))
 }
 
@@ -372,32 +395,54 @@ fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     sc.t[a as usize] = t;
 }
 
-fn valid<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) -> bool {
+enum Validity {
+    Valid,
+    /// The owner has changed since: it has a newer event already.
+    Stale,
+    /// The partner has changed: the owner must predict again.
+    PartnerChanged,
+}
+
+fn validity<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) -> Validity {
     let alive = |x: u32| w.critters.slot(x).is_some_and(|c| c.alive);
     if !alive(ev.a) || sc.count[ev.a as usize] != ev.ca {
-        return false;
+        return Validity::Stale;
     }
-    match ev.kind {
+    let ok = match ev.kind {
         PAIR => alive(ev.b) && sc.count[ev.b as usize] == ev.cb,
-        WALL | RECHECK => alive(ev.b) && (ev.kind == WALL || sc.count[ev.b as usize] == ev.cb),
+        WALL => alive(ev.b),
         _ => true,
+    };
+    if ok {
+        Validity::Valid
+    } else {
+        Validity::PartnerChanged
     }
 }
 
+/// Offers an event to the running prediction: each critter keeps only its earliest event in
+/// the heap (a stale partner makes it predict again when that event comes up).
+#[inline]
 fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: u8) {
-    let cb = if kind == PAIR || kind == RECHECK {
+    if sc.cand.is_some_and(|c| time > c.time) {
+        return;
+    }
+    let cb = if kind == PAIR {
         sc.count.get(b as usize).copied().unwrap_or(0)
     } else {
         0
     };
-    sc.heap.push(Reverse(Ev {
+    let ev = Ev {
         time,
         a,
         b,
         kind,
         ca: sc.count[a as usize],
         cb,
-    }));
+    };
+    if sc.cand.is_none_or(|c| ev < c) {
+        sc.cand = Some(ev);
+    }
 }
 
 /// Predicts every next event of disk `a` from time `t`. `initial`: pairs only with higher slots.
@@ -406,7 +451,6 @@ fn predict_all<V: Vector>(
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
-    initial: bool,
 ) -> Result<(), Error> {
     let Some(c) = w.critters.slot(a) else {
         return Ok(());
@@ -414,9 +458,13 @@ fn predict_all<V: Vector>(
     if !c.alive || c.is_wall() {
         return Ok(());
     }
+    sc.cand = None;
+    sc.predictions += 1;
+    let mine = state_at(w, sc, a, t);
     let home = sc.cell[a as usize] as usize;
     let dims = sc.dims;
     let hc = coords(&dims, home);
+    let small = dims[..V::DIM].iter().any(|&n| n < 3);
     let mut seen = [usize::MAX; 27];
     let mut nseen = 0;
     let reach = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
@@ -429,55 +477,57 @@ fn predict_all<V: Vector>(
                     continue;
                 }
                 let k = key(&dims, cc);
-                if seen[..nseen].contains(&k) {
-                    continue;
-                }
-                seen[nseen] = k;
-                nseen += 1;
-                for i in 0..sc.cells[k].len() {
-                    let b = sc.cells[k][i];
-                    if b == a || (initial && b < a) {
+                if small {
+                    // Fewer than three cells along an axis: neighbours repeat.
+                    if seen[..nseen].contains(&k) {
                         continue;
                     }
-                    predict_pair_or_wall(w, sc, a, b, t)?;
+                    seen[nseen] = k;
+                    nseen += 1;
+                }
+                for i in 0..sc.cells[k].len() {
+                    let b = sc.cells[k][i];
+                    if b == a {
+                        continue;
+                    }
+                    predict_pair_or_wall(w, sc, a, b, t, mine)?;
                 }
             }
         }
     }
     for i in 0..sc.cell_walls[home].len() {
         let b = sc.cell_walls[home][i];
-        predict_pair_or_wall(w, sc, a, b, t)?;
+        predict_pair_or_wall(w, sc, a, b, t, mine)?;
     }
     predict_border(w, sc, a, t);
     predict_cell(w, sc, a, t);
+    if let Some(ev) = sc.cand.take() {
+        sc.heap.push(Reverse(ev));
+    }
     Ok(())
 }
 
+#[inline]
 fn predict_pair_or_wall<V: Vector>(
     w: &mut World<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
     t: f64,
+    mine: (V, V, V),
 ) -> Result<(), Error> {
+    sc.pair_tests += 1;
     let (Some(ca), Some(cb)) = (w.critters.slot(a), w.critters.slot(b)) else {
         return Ok(());
     };
     if !ca.alive || !cb.alive {
         return Ok(());
     }
-    let rule = w
-        .rules
-        .rule(&w.kinds, &w.topo, ca, cb)
-        .map_err(|e| at_step(e, w.step_count))?;
-    if rule == Some(PairRule::DontCollide) {
-        return Ok(());
-    }
     let horizon = sc.t_end - t;
     if horizon < 0.0 {
         return Ok(());
     }
-    let (pa, va, aa) = state_at(w, sc, a, t);
+    let (pa, va, aa) = mine;
     let is_wall = cb.is_wall();
     let just_met = sc.last[a as usize] == b && (is_wall || sc.last[b as usize] == a);
     let (kind, s) = if let Shape::Wall(wall) = &cb.shape {
@@ -526,8 +576,7 @@ fn predict_pair_or_wall<V: Vector>(
                 Advance::Hit(s) => Some(s),
                 Advance::Miss => None,
                 Advance::Continue(s) => {
-                    let (x, y) = (a.min(b), a.max(b));
-                    push(sc, t + s, x, y, RECHECK);
+                    push(sc, t + s, a, b, RECHECK);
                     None
                 }
             }
@@ -535,16 +584,25 @@ fn predict_pair_or_wall<V: Vector>(
         (PAIR, s)
     };
     if let Some(s) = s {
+        if s > horizon || sc.cand.is_some_and(|c| t + s > c.time) {
+            return Ok(());
+        }
+        let (ca, cb) = (
+            w.critters.slot(a).expect("live"),
+            w.critters.slot(b).expect("live"),
+        );
+        let rule = w
+            .rules
+            .rule(&w.kinds, &w.topo, ca, cb)
+            .map_err(|e| at_step(e, w.step_count))?;
+        if rule == Some(PairRule::DontCollide) {
+            return Ok(());
+        }
         if s == 0.0 && (just_met || sc.stuck.contains(&pair_key(a, b))) {
             return Ok(()); // the pair was handled; its hook chose to leave them so
         }
         if s <= horizon {
-            let (x, y) = if kind == PAIR {
-                (a.min(b), a.max(b))
-            } else {
-                (a, b)
-            };
-            push(sc, t + s, x, y, kind);
+            push(sc, t + s, a, b, kind);
         }
     }
     Ok(())
