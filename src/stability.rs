@@ -365,3 +365,69 @@ pub fn first_tunnelling_speed(method: Method) -> Result<Option<f64>, Error> {
     }
     Ok(None)
 }
+
+/// One point of the speed-against-accuracy chart.
+#[derive(Clone, Debug)]
+pub struct ChartPoint {
+    /// The method.
+    pub method: Method,
+    /// The time step.
+    pub dt: f64,
+    /// Wall time per simulated second per critter (seconds).
+    pub cost: f64,
+    /// Root-mean-square position error against the event-driven reference, in radii.
+    pub error: f64,
+}
+
+/// The chart's scene: 100 disks of radius 0.5 at packing fraction 0.3 in a walled box, speeds
+/// up to 6 per axis, one simulated second.
+fn chart_gas(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
+    let mut w = crate::scenes::gas::<DVec2>(&crate::scenes::GasParams {
+        n: 100,
+        packing: 0.3,
+        dt,
+        seed: 7,
+        ..Default::default()
+    })?;
+    let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id()).collect();
+    for id in ids {
+        if let Some(c) = w.get_mut(id) {
+            c.vel = c.vel * 6.0;
+        }
+    }
+    w.set_method(method)?;
+    Ok(w)
+}
+
+/// Runs the chart's sweep: each method at dt = 1/15 ... 1/960 over one simulated second, error
+/// against the event method at dt = 1 (one step: no step boundaries at all).
+pub fn chart_points(methods: &[Method]) -> Result<Vec<ChartPoint>, Error> {
+    let mut reference = chart_gas(Method::Event, 1.0)?;
+    reference.step()?;
+    let want: Vec<DVec2> = reference.critters().iter().map(|c| c.pos).collect();
+    let mut out = Vec::new();
+    for &method in methods {
+        for k in 0..7 {
+            let dt = 1.0 / (15.0 * 2f64.powi(k));
+            let mut w = chart_gas(method, dt)?;
+            let steps = (1.0 / dt).round() as u64;
+            let n = w.critters().iter().filter(|c| !c.is_wall()).count() as f64;
+            let start = std::time::Instant::now();
+            w.run(steps)?;
+            let cost = start.elapsed().as_secs_f64() / n;
+            let mut sum = 0.0;
+            for (c, p) in w.critters().iter().zip(&want) {
+                if !c.is_wall() {
+                    sum += (c.pos - *p).length_squared() / (c.radius() * c.radius());
+                }
+            }
+            out.push(ChartPoint {
+                method,
+                dt,
+                cost,
+                error: (sum / n).sqrt(),
+            });
+        }
+    }
+    Ok(out)
+}

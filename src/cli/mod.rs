@@ -2,6 +2,7 @@
 //!
 //! `src/main.rs` parses, calls [`execute`], and turns the outcome into an exit code.
 
+pub mod chart;
 pub mod check;
 pub mod run;
 pub mod stability;
@@ -27,6 +28,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Run script tests: every `fn test_*()` in scripts/tests/*.rhai.
     Test(test::TestArgs),
+    /// Chart cost against error for every method; writes docs/speed-vs-accuracy.svg and .png.
+    Chart(chart::ChartArgs),
     /// Run the stress scenes under every collision method and print the error table.
     Stability(stability::StabilityArgs),
 }
@@ -37,6 +40,7 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         Some(Command::Run(args)) => run::run(&args, out),
         Some(Command::Check(args)) => check::run(&args, out),
         Some(Command::Test(args)) => test::run(&args, out),
+        Some(Command::Chart(args)) => chart::run(&args, out),
         Some(Command::Stability(args)) => stability::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
