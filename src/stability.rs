@@ -392,7 +392,7 @@ fn chart_gas(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
     let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id()).collect();
     for id in ids {
         if let Some(c) = w.get_mut(id) {
-            c.vel = c.vel * 6.0;
+            c.vel *= 6.0;
         }
     }
     w.set_method(method)?;
