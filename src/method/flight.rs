@@ -81,10 +81,25 @@ impl Ord for Ev {
     }
 }
 
+/// What predictions read about a critter, kept compact and contiguous (the critters themselves
+/// are large and scattered); refreshed whenever the flight or a hook changes the critter.
+#[derive(Clone, Copy, Debug, Default)]
+struct Body<V> {
+    pos: V,
+    vel: V,
+    /// The body's own clock: `pos` and `vel` hold at this time.
+    t: f64,
+    radius: f64,
+    /// Accelerates with the flight's gravity (free disks).
+    free: bool,
+    alive: bool,
+    wall: bool,
+}
+
 /// Per-world scratch kept between steps so a step allocates nothing once warmed up.
 #[derive(Default)]
 pub(crate) struct Scratch<V> {
-    t: Vec<f64>,
+    body: Vec<Body<V>>,
     count: Vec<u32>,
     cell: Vec<u32>,
     last: Vec<u32>,
@@ -142,7 +157,7 @@ fn run_with<V: Vector>(
         if ev.time > t_end {
             break;
         }
-        match validity(w, sc, &ev) {
+        match validity(sc, &ev) {
             Validity::Stale => continue,
             Validity::PartnerChanged => {
                 predict_all(w, sc, ev.a, ev.time)?;
@@ -161,8 +176,14 @@ fn run_with<V: Vector>(
                 advance(w, sc, ev.a, t);
                 advance(w, sc, ev.b, t);
                 stats.contacts += 1;
+                let deaths = w.pending.deaths.len();
                 if collide(w, sc, ev.a, ev.b, t)? {
                     stats.collisions += 1;
+                }
+                // A hook may kill third critters: their bodies must know.
+                for i in deaths..w.pending.deaths.len() {
+                    let x = w.pending.deaths[i].index;
+                    refresh(w, sc, x);
                 }
                 if let (Some(x), Some(y)) = (w.critters.slot(ev.a), w.critters.slot(ev.b)) {
                     if x.alive && y.alive {
@@ -183,19 +204,24 @@ fn run_with<V: Vector>(
                     if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
                         sc.count[x as usize] = sc.count[x as usize].wrapping_add(1);
                         relocate(w, sc, x);
-                        predict_all(w, sc, x, t)?;
+                        refresh(w, sc, x);
                     }
+                }
+                for x in [ev.a, ev.b] {
+                    predict_all(w, sc, x, t)?;
                 }
             }
             BORDER => {
                 advance(w, sc, ev.a, t);
                 bounce_border(w, ev.a, ev.b);
+                refresh(w, sc, ev.a);
                 sc.last[ev.a as usize] = BORDER_TAG + ev.b;
                 sc.count[ev.a as usize] = sc.count[ev.a as usize].wrapping_add(1);
                 predict_all(w, sc, ev.a, t)?;
             }
             CELL => {
                 cross_cell(w, sc, ev.a, ev.b, t);
+                refresh(w, sc, ev.a);
                 predict_all(w, sc, ev.a, t)?;
             }
             _ => {
@@ -234,8 +260,11 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
         v.resize(n, NONE);
     }
     sc.count.iter_mut().for_each(|c| *c = 0);
-    sc.t.clear();
-    sc.t.resize(n, 0.0);
+    sc.body.clear();
+    sc.body.resize(n, Body::default());
+    for a in 0..n as u32 {
+        refresh(w, sc, a);
+    }
     sc.last_t.clear();
     sc.last_t.resize(n, f64::NEG_INFINITY);
     sc.acc = acc;
@@ -363,36 +392,54 @@ fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> usize {
     key(&sc.dims, c)
 }
 
-/// Position and velocity of slot `a` at time `t` (its own clock is `sc.t[a]`).
+/// Copies critter `a` into its body (after the flight or a hook changed it).
 #[inline]
-fn state_at<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
-    let c = w.critters.slot(a).expect("live slot");
-    let acc = if c.fixed || c.is_wall() {
-        V::zero()
-    } else {
-        sc.acc
+fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
+    let t = sc.body[a as usize].t;
+    sc.body[a as usize] = match w.critters.slot(a) {
+        Some(c) => Body {
+            pos: c.pos,
+            vel: c.vel,
+            t,
+            radius: c.radius,
+            free: !c.fixed && !c.is_wall(),
+            alive: c.alive,
+            wall: c.is_wall(),
+        },
+        None => Body::default(),
     };
-    let h = t - sc.t[a as usize];
+}
+
+/// Position, velocity and acceleration of body `a` at time `t` (its own clock is `body.t`).
+#[inline]
+fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
+    let b = &sc.body[a as usize];
+    let acc = if b.free { sc.acc } else { V::zero() };
+    let h = t - b.t;
     if h == 0.0 {
-        return (c.pos, c.vel, acc);
+        return (b.pos, b.vel, acc);
     }
     (
-        c.pos + c.vel * h + acc * (0.5 * h * h),
-        c.vel + acc * h,
+        b.pos + b.vel * h + acc * (0.5 * h * h),
+        b.vel + acc * h,
         acc,
     )
 }
 
 fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
-    let Some(c) = w.critters.slot(a) else { return };
-    if !c.alive || c.is_wall() {
+    let b = sc.body[a as usize];
+    if !b.alive || b.wall {
         return;
     }
-    let (p, v, _) = state_at(w, sc, a, t);
-    let c = w.critters.slot_mut(a).expect("live slot");
-    c.pos = p;
-    c.vel = v;
-    sc.t[a as usize] = t;
+    let (p, v, _) = state_at(sc, a, t);
+    let body = &mut sc.body[a as usize];
+    body.pos = p;
+    body.vel = v;
+    body.t = t;
+    if let Some(c) = w.critters.slot_mut(a) {
+        c.pos = p;
+        c.vel = v;
+    }
 }
 
 enum Validity {
@@ -403,8 +450,8 @@ enum Validity {
     PartnerChanged,
 }
 
-fn validity<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) -> Validity {
-    let alive = |x: u32| w.critters.slot(x).is_some_and(|c| c.alive);
+fn validity<V: Vector>(sc: &Scratch<V>, ev: &Ev) -> Validity {
+    let alive = |x: u32| sc.body[x as usize].alive;
     if !alive(ev.a) || sc.count[ev.a as usize] != ev.ca {
         return Validity::Stale;
     }
@@ -452,15 +499,13 @@ fn predict_all<V: Vector>(
     a: u32,
     t: f64,
 ) -> Result<(), Error> {
-    let Some(c) = w.critters.slot(a) else {
-        return Ok(());
-    };
-    if !c.alive || c.is_wall() {
+    let me = sc.body[a as usize];
+    if !me.alive || me.wall {
         return Ok(());
     }
     sc.cand = None;
     sc.predictions += 1;
-    let mine = state_at(w, sc, a, t);
+    let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
     let dims = sc.dims;
     let hc = coords(&dims, home);
@@ -517,10 +562,8 @@ fn predict_pair_or_wall<V: Vector>(
     mine: (V, V, V),
 ) -> Result<(), Error> {
     sc.pair_tests += 1;
-    let (Some(ca), Some(cb)) = (w.critters.slot(a), w.critters.slot(b)) else {
-        return Ok(());
-    };
-    if !ca.alive || !cb.alive {
+    let (body_a, body_b) = (sc.body[a as usize], sc.body[b as usize]);
+    if !body_b.alive {
         return Ok(());
     }
     let horizon = sc.t_end - t;
@@ -528,11 +571,17 @@ fn predict_pair_or_wall<V: Vector>(
         return Ok(());
     }
     let (pa, va, aa) = mine;
-    let is_wall = cb.is_wall();
+    let is_wall = body_b.wall;
     let just_met = sc.last[a as usize] == b && (is_wall || sc.last[b as usize] == a);
-    let (kind, s) = if let Shape::Wall(wall) = &cb.shape {
+    let (kind, s) = if is_wall {
+        let Some(cb) = w.critters.slot(b) else {
+            return Ok(());
+        };
+        let Shape::Wall(wall) = &cb.shape else {
+            return Ok(());
+        };
         let d = w.topo.delta(cb.pos, pa);
-        let r = ca.radius * (1.0 - SKIN);
+        let r = body_a.radius * (1.0 - SKIN);
         let s = if aa.length_squared() == 0.0 {
             toi_wall_ball(wall, d, va, r)
         } else if contact_wall_ball(wall, d, r).is_some() {
@@ -549,7 +598,7 @@ fn predict_pair_or_wall<V: Vector>(
                     dist - r
                 }
             };
-            match advance_to_contact(gap, vb, horizon, ca.radius) {
+            match advance_to_contact(gap, vb, horizon, body_a.radius) {
                 Advance::Hit(s) => Some(s),
                 Advance::Miss => None,
                 Advance::Continue(s) => {
@@ -560,11 +609,11 @@ fn predict_pair_or_wall<V: Vector>(
         };
         (WALL, s)
     } else {
-        let (pb, vb, ab) = state_at(w, sc, b, t);
+        let (pb, vb, ab) = state_at(sc, b, t);
         let d = w.topo.delta(pa, pb);
         let wv = vb - va;
         let ar = ab - aa;
-        let r = (ca.radius + cb.radius) * (1.0 - SKIN);
+        let r = (body_a.radius + body_b.radius) * (1.0 - SKIN);
         let s = if d.length_squared() < r * r {
             Some(0.0) // overlapping: collide now (approaching or not)
         } else if ar.length_squared() == 0.0 {
@@ -641,7 +690,7 @@ fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) 
     }
     let c = w.critters.slot(a).expect("live slot");
     let r = c.radius;
-    let (p, v, acc) = state_at(w, sc, a, t);
+    let (p, v, acc) = state_at(sc, a, t);
     let just = sc.last[a as usize];
     for axis in 0..V::DIM {
         let lo = w.topo.min.get(axis) + r;
@@ -695,7 +744,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
 
 #[allow(clippy::needless_range_loop)]
 fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
-    let (p, v, acc) = state_at(w, sc, a, t);
+    let (p, v, acc) = state_at(sc, a, t);
     let cc = coords(&sc.dims, sc.cell[a as usize] as usize);
     let mut best = (f64::INFINITY, 0u32);
     for axis in 0..V::DIM {
