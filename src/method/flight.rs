@@ -548,6 +548,12 @@ fn predict_all<V: Vector>(
     predict_cell(w, sc, a, t);
     if let Some(ev) = sc.cand.take() {
         sc.heap.push(Reverse(ev));
+        if sc.heap.len() > 3 * sc.count.len() + 1024 {
+            // Lazy invalidation leaves stale events behind; drop those whose owner has
+            // predicted again since, so the heap stays about one event per critter.
+            let count = &sc.count;
+            sc.heap.retain(|Reverse(e)| count[e.a as usize] == e.ca);
+        }
     }
     Ok(())
 }
