@@ -266,3 +266,25 @@ fn print_bullet_sweep() {
         println!("{m}: {}", t.join(" "));
     }
 }
+
+/// The exactness target: kinetic energy to 1e-10 relative over 1e6 collisions at e = 1
+/// (about 5 s in release; `cargo nextest run --run-ignored ignored-only event_energy`).
+#[test]
+#[ignore]
+fn event_energy_drift_over_a_million_collisions_is_below_1e_minus_10() {
+    let mut w = gas::<DVec2>(&GasParams {
+        n: 10_000,
+        packing: 0.4,
+        dt: 5.0,
+        border: Border::Wrap,
+        ..GasParams::default()
+    })
+    .unwrap();
+    w.set_method(Method::Event).unwrap();
+    let e0 = w.kinetic_energy();
+    while w.totals().impacts < 1_000_000 {
+        w.step().unwrap();
+    }
+    let drift = (w.kinetic_energy() - e0) / e0;
+    assert!(drift.abs() < 1e-10, "drift {drift}");
+}
