@@ -90,12 +90,16 @@ fn main() {
     g2.run(10).expect("warm up");
     g2.step().expect("step");
     group.throughput(Throughput::Elements(g2.stats().impacts as u64));
-    group.bench_function("gas2d_10k_phi0.4_step0.2", |b| b.iter(|| g2.step().expect("step")));
+    group.bench_function("gas2d_10k_phi0.4_step0.2", |b| {
+        b.iter(|| g2.step().expect("step"))
+    });
     let mut g3 = periodic_gas::<DVec3>(32_000, 0.4, 0.05);
     g3.run(4).expect("warm up");
     g3.step().expect("step");
     group.throughput(Throughput::Elements(g3.stats().impacts as u64));
-    group.bench_function("gas3d_32k_phi0.4_step0.05", |b| b.iter(|| g3.step().expect("step")));
+    group.bench_function("gas3d_32k_phi0.4_step0.05", |b| {
+        b.iter(|| g3.step().expect("step"))
+    });
     group.finish();
     c.final_summary();
 }
