@@ -288,3 +288,31 @@ fn event_energy_drift_over_a_million_collisions_is_below_1e_minus_10() {
     let drift = (w.kinetic_energy() - e0) / e0;
     assert!(drift.abs() < 1e-10, "drift {drift}");
 }
+
+#[test]
+fn event_ball_bouncing_on_the_border_under_gravity_keeps_its_parabola() {
+    // The floor is the world box's bouncing border this time (e = 1): the same closed form as
+    // against a wall, apexes at 0, 2T, 4T, ...; the ball never leaves the box.
+    let g = 9.81;
+    let (y0, r) = (5.0, 0.5);
+    let mut w = World::new(
+        WorldConfig::new(DVec2::new(-5.0, 0.0), DVec2::new(5.0, 10.0))
+            .gravity(DVec2::new(0.0, -g))
+            .dt(0.05)
+            .method(Method::Event),
+    )
+    .unwrap();
+    let id = w
+        .spawn(CritterSpec::ball(DVec2::new(0.0, y0)).radius(r))
+        .unwrap();
+    let big_t = (2.0 * (y0 - r) / g).sqrt();
+    for _ in 0..200 {
+        w.step().unwrap();
+        let t = w.time();
+        let k = ((t + big_t) / (2.0 * big_t)).floor();
+        let s = t - 2.0 * big_t * k;
+        let y = y0 - 0.5 * g * s * s;
+        let c = w.get(id).unwrap();
+        assert!((c.pos.y - y).abs() < 1e-7, "t {t}: {} vs {y}", c.pos.y);
+    }
+}

@@ -710,7 +710,7 @@ fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) 
             // Distance to the bound, positive inside.
             let gap = (bound - x) * outward;
             let s = if gap <= 0.0 {
-                (vx * outward > 0.0 || (vx == 0.0 && ax * outward > 0.0)).then_some(0.0)
+                on_bound(vx * outward, ax * outward)
             } else {
                 smallest_nonneg_root(0.5 * ax * outward, vx * outward, -gap)
             };
@@ -724,6 +724,19 @@ fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) 
                 }
             }
         }
+    }
+}
+
+/// When a critter on (or a hair past) a bound leaves through it, given its outward velocity
+/// `v` and acceleration `a`: now if moving (or, at rest, accelerating) outward; after the
+/// parabola returns, `-2 v / a`, if moving inward but accelerated outward; never otherwise.
+fn on_bound(v: f64, a: f64) -> Option<f64> {
+    if v > 0.0 || (v == 0.0 && a > 0.0) {
+        Some(0.0)
+    } else if v < 0.0 && a > 0.0 {
+        Some(-2.0 * v / a)
+    } else {
+        None
     }
 }
 
@@ -772,11 +785,13 @@ fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
             }
             let outward = if dir == 1 { 1.0 } else { -1.0 };
             let bound = if dir == 1 { hi } else { lo };
-            let gap = ((bound - x) * outward).max(0.0);
-            if let Some(s) = smallest_nonneg_root(0.5 * ax * outward, vx * outward, -gap) {
-                if gap == 0.0 && vx * outward <= 0.0 && !(vx == 0.0 && ax * outward > 0.0) {
-                    continue;
-                }
+            let gap = (bound - x) * outward;
+            let s = if gap <= 0.0 {
+                on_bound(vx * outward, ax * outward)
+            } else {
+                smallest_nonneg_root(0.5 * ax * outward, vx * outward, -gap)
+            };
+            if let Some(s) = s {
                 if s < best.0 {
                     best = (s, axis as u32 * 2 + dir);
                 }
