@@ -2,6 +2,7 @@
 //!
 //! `src/main.rs` parses, calls [`execute`], and turns the outcome into an exit code.
 
+pub mod chart;
 pub mod check;
 pub mod diff;
 pub mod export;
@@ -10,6 +11,7 @@ pub mod record;
 pub mod recover;
 pub mod replay;
 pub mod run;
+pub mod stability;
 pub mod test;
 
 use clap::{Parser, Subcommand};
@@ -42,6 +44,10 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Make a readable, complete file from a cut-off recording (complete chunks kept).
     Recover(recover::RecoverArgs),
+    /// Chart cost against error for every method; writes docs/speed-vs-accuracy.svg and .png.
+    Chart(chart::ChartArgs),
+    /// Run the stress scenes under every collision method and print the error table.
+    Stability(stability::StabilityArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
@@ -55,6 +61,8 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         Some(Command::Diff(args)) => diff::run(&args, out),
         Some(Command::Export(args)) => export::run(&args, out),
         Some(Command::Recover(args)) => recover::run(&args, out),
+        Some(Command::Chart(args)) => chart::run(&args, out),
+        Some(Command::Stability(args)) => stability::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }

@@ -51,6 +51,9 @@ pub struct RunArgs {
     /// Number of critters, for scenes that have a natural count (gas, cradle, pegs).
     #[arg(short = 'n', long)]
     pub n: Option<usize>,
+    /// Collision method: discrete, substep:N, swept, event or auto (default: the scene's own).
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<crate::method::Method>,
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
@@ -82,6 +85,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let mut scene = load(args)?;
     if let Some(dt) = args.dt {
         scene.world.set_dt(dt)?;
+    }
+    if let Some(m) = args.method {
+        scene.world.set_method(m)?;
     }
     let name = scene.name.clone();
     let steps = args.steps.unwrap_or(scene.default_steps);
@@ -134,6 +140,19 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let done = scene.world.step_count();
     summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
+    let method = scene.world.method();
+    writeln!(out, "method       {method}")?;
+    if let Some((chose, why)) = scene.world.auto_choice() {
+        writeln!(out, "auto chose   {chose} (last step): {why}")?;
+    }
+    let t = scene.world.totals();
+    if t.events > 0 || t.budget_exceeded > 0 {
+        writeln!(
+            out,
+            "events       {} processed, {} steps over budget",
+            t.events, t.budget_exceeded
+        )?;
+    }
     if let Some((at, reason)) = &stopped {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
@@ -197,6 +216,10 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         &sets,
         &options,
     )?)
+}
+
+fn parse_method(s: &str) -> Result<crate::method::Method, String> {
+    s.parse()
 }
 
 fn progress_bar(steps: u64) -> ProgressBar {

@@ -71,12 +71,10 @@ fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
                 )?
             }
             "method" => {
-                let m = value.to_string();
-                if m != "discrete" {
-                    return fail(format!(
-                        "method '{m}' is not available yet: the engine has the discrete method only (method: \"discrete\")"
-                    ));
-                }
+                config.method = value
+                    .to_string()
+                    .parse::<crate::method::Method>()
+                    .map_or_else(fail, Ok)?;
             }
             "steps" => {
                 steps = Some(value.as_int().ok().filter(|s| *s >= 0).map_or_else(
