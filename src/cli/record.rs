@@ -74,7 +74,7 @@ pub fn run_meta(args: &RunArgs, scene: &Scene, steps: u64) -> RunMeta {
         dt: world.dt(),
         dt_override: args.dt,
         steps,
-        method: "discrete".into(),
+        method: world.method().to_string(),
         dim: world.dim(),
         border: format!("{:?}", world.border()).to_lowercase(),
         n: args.n,

@@ -85,6 +85,11 @@ pub fn rebuild(rec: &Recording) -> anyhow::Result<Rebuilt> {
             (scene, Some(dir))
         }
     };
+    let method: crate::method::Method = meta
+        .method
+        .parse()
+        .map_err(|e| anyhow::anyhow!("the recording's method '{}': {e}", meta.method))?;
+    scene.world.set_method(method)?;
     if let Some(dt) = meta.dt_override {
         scene.world.set_dt(dt)?;
     }

@@ -140,6 +140,9 @@ fn make_world(host: &Rc<Host>, map: &Map) -> Res<WorldRef> {
     };
     host.scene_steps.set(steps);
     host.put_scene(Scene::new("world", any, steps.unwrap_or(600)));
+    if host.testing.get() {
+        super::testing::start_recording_pub(host)?;
+    }
     Ok(WorldRef)
 }
 
