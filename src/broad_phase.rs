@@ -54,16 +54,14 @@ struct Level<V> {
     wrap: [bool; 3],
     /// Object indices on this level.
     members: Vec<u32>,
-    /// Cell key and cell coordinates of each member (parallel to `members`).
+    /// Cell key of each member (parallel to `members`).
     keys: Vec<u32>,
-    coords: Vec<[u32; 3]>,
     /// `start[k]..start[k + 1]` indexes `sorted` for cell `k`.
     start: Vec<u32>,
     /// The members' objects in cell order, so the pair loops read memory in order.
     sorted: Vec<BroadObject<V>>,
-    /// Cell key and coordinates of each entry of `sorted`.
+    /// Cell key of each entry of `sorted`.
     sorted_keys: Vec<u32>,
-    sorted_coords: Vec<[u32; 3]>,
 }
 
 impl<V> Default for Level<V> {
@@ -74,11 +72,9 @@ impl<V> Default for Level<V> {
             wrap: [false; 3],
             members: Vec::new(),
             keys: Vec::new(),
-            coords: Vec::new(),
             start: Vec::new(),
             sorted: Vec::new(),
             sorted_keys: Vec::new(),
-            sorted_coords: Vec::new(),
         }
     }
 }
@@ -209,6 +205,16 @@ impl<V: Vector> Level<V> {
         }
     }
 
+    /// The cell coordinates of a key.
+    #[inline]
+    fn decode(&self, key: usize) -> [usize; 3] {
+        let plane = self.dims[0] * self.dims[1];
+        let z = key / plane;
+        let rest = key - z * plane;
+        let y = rest / self.dims[0];
+        [rest - y * self.dims[0], y, z]
+    }
+
     #[inline]
     fn cell(&self, key: usize) -> &[BroadObject<V>] {
         &self.sorted[self.start[key] as usize..self.start[key + 1] as usize]
@@ -239,12 +245,16 @@ impl<V: Vector> Level<V> {
 
     /// Sizes the level's grid for cells at least `cell` wide (and at most `limit` cells), sorts
     /// its members by cell, and returns the cell width used.
+    /// The sorted copies are widened by `pad` and, with `by_index`, named by their index in
+    /// `objs` instead of their slot.
     fn build(
         &mut self,
         objs: &[BroadObject<V>],
         topo: &Topology<V>,
         mut cell: f64,
         limit: f64,
+        pad: f64,
+        by_index: bool,
     ) -> f64 {
         let size = topo.size();
         loop {
@@ -283,12 +293,9 @@ impl<V: Vector> Level<V> {
         self.start.clear();
         self.start.resize(ncells + 1, 0);
         self.keys.clear();
-        self.coords.clear();
         for &i in &self.members {
-            let c = self.coords(topo, objs[i as usize].center);
-            let k = self.key(c);
+            let k = self.key(self.coords(topo, objs[i as usize].center));
             self.keys.push(k as u32);
-            self.coords.push([c[0] as u32, c[1] as u32, c[2] as u32]);
             self.start[k] += 1;
         }
         // Exclusive prefix sum, carried in a register (a loop through memory stalls on each add).
@@ -309,16 +316,19 @@ impl<V: Vector> Level<V> {
         self.sorted.resize(m, filler);
         self.sorted_keys.clear();
         self.sorted_keys.resize(m, 0);
-        self.sorted_coords.clear();
-        self.sorted_coords.resize(m, [0; 3]);
         // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
         // the shift below turns ends back into starts.
         for (j, &i) in self.members.iter().enumerate() {
             let k = self.keys[j] as usize;
             let at = self.start[k] as usize;
-            self.sorted[at] = objs[i as usize];
+            let o = &objs[i as usize];
+            self.sorted[at] = BroadObject {
+                center: o.center,
+                half: o.half + V::splat(pad),
+                slot: if by_index { i } else { o.slot },
+                is_wall: o.is_wall,
+            };
             self.sorted_keys[at] = k as u32;
-            self.sorted_coords[at] = self.coords[j];
             self.start[k] += 1;
         }
         for k in (1..=ncells).rev() {
@@ -338,7 +348,6 @@ struct PairList<V> {
     skin: f64,
     refs: Vec<BroadObject<V>>,
     pairs: Vec<(u32, u32)>,
-    scratch: Vec<BroadObject<V>>,
     rebuilds: u64,
 }
 
@@ -349,7 +358,6 @@ impl<V> Default for PairList<V> {
             skin: 0.0,
             refs: Vec::new(),
             pairs: Vec::new(),
-            scratch: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -490,20 +498,11 @@ impl<V: Vector> BroadPhase<V> {
             |o: &BroadObject<V>| (0..V::DIM).map(|a| 2.0 * o.half.get(a)).fold(0.0, f64::max);
         let s0 = objs.iter().map(width).fold(f64::INFINITY, f64::min);
         let skin = SKIN * s0;
-        // Widened copies, named by their index so the kept pairs index `objs`.
-        let mut widened = std::mem::take(&mut self.list.scratch);
-        widened.clear();
-        widened.extend(objs.iter().enumerate().map(|(i, o)| BroadObject {
-            center: o.center,
-            half: o.half + V::splat(0.5 * skin),
-            slot: i as u32,
-            is_wall: o.is_wall,
-        }));
+        // Boxes widened by half the skin, pairs named by index so they index `objs`.
         let mut pairs = std::mem::take(&mut self.list.pairs);
         pairs.clear();
-        self.grid(&widened, topo, &mut pairs);
+        self.grid_padded(objs, topo, &mut pairs, 0.5 * skin, true);
         self.list.pairs = pairs;
-        self.list.scratch = widened;
         self.list.refs.clear();
         self.list.refs.extend_from_slice(objs);
         self.list.skin = skin;
@@ -534,11 +533,24 @@ impl<V: Vector> BroadPhase<V> {
     }
 
     fn grid(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+        self.grid_padded(objs, topo, out, 0.0, false);
+    }
+
+    /// The grid's pairs of the boxes widened by `pad`, named by slot, or with `by_index` by
+    /// their index in `objs`.
+    fn grid_padded(
+        &mut self,
+        objs: &[BroadObject<V>],
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+        pad: f64,
+        by_index: bool,
+    ) {
         // Widths, finest width, and each object's level.
         let width = |o: &BroadObject<V>| {
             let mut w: f64 = 0.0;
             for axis in 0..V::DIM {
-                w = w.max(2.0 * o.half.get(axis));
+                w = w.max(2.0 * (o.half.get(axis) + pad));
             }
             w
         };
@@ -584,7 +596,7 @@ impl<V: Vector> BroadPhase<V> {
             }
             used.push(l);
             let cell = (s0 * (l as f64).exp2()).max(floor_cell);
-            floor_cell = self.levels[l].build(objs, topo, cell, limit);
+            floor_cell = self.levels[l].build(objs, topo, cell, limit, pad, by_index);
         }
         self.levels_used = used.len();
 
@@ -603,7 +615,7 @@ impl<V: Vector> BroadPhase<V> {
                     end += 1;
                 }
                 let here = &level.sorted[begin..end];
-                let c = level.sorted_coords[begin].map(|x| x as usize);
+                let c = level.decode(key);
                 begin = end;
                 for (j, a) in here.iter().enumerate() {
                     for b in &here[j + 1..] {
