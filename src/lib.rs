@@ -39,6 +39,8 @@ pub mod scenes;
 pub mod script;
 
 pub mod vector;
+#[cfg(feature = "rerun")]
+pub mod viewer;
 pub mod wall;
 pub mod world;
 

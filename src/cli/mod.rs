@@ -5,6 +5,7 @@
 pub mod check;
 pub mod run;
 pub mod test;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 

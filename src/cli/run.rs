@@ -53,6 +53,9 @@ pub struct RunArgs {
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
+    /// Watching the run.
+    #[command(flatten)]
+    pub view: super::view::ViewArgs,
 }
 
 /// Runs the command.
@@ -84,12 +87,15 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
 
     let energy0 = scene.world.kinetic_energy();
     let momentum0 = scene.world.momentum();
+    let mut viewer = super::view::Viewer::open(&args.view, &scene.world)?;
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
     for i in 0..steps {
         let step = scene.world.step_count();
+        let step_started = Instant::now();
         let outcome = scene.step();
+        viewer.step(&scene.world, step_started.elapsed());
         let log = scene.world.log();
         if !log.is_empty() {
             bar.suspend(|| {
@@ -108,8 +114,17 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     }
     let wall = started.elapsed();
     bar.finish_and_clear();
+    let viewing = viewer.finish();
     let done = scene.world.step_count();
     summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
+    if let Some(spent) = viewing {
+        writeln!(
+            out,
+            "viewer       {:.3} s logging to Rerun ({:.1}% of the run)",
+            spent.as_secs_f64(),
+            100.0 * spent.as_secs_f64() / wall.as_secs_f64().max(1e-9)
+        )?;
+    }
     if let Some((at, reason)) = stopped {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
