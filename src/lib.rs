@@ -32,11 +32,14 @@ pub mod critter_set;
 pub mod error;
 pub mod hash;
 pub mod kind;
+pub mod method;
+pub mod recording;
 pub mod response;
 pub mod rng;
 pub mod rules;
 pub mod scenes;
 pub mod script;
+pub mod stability;
 
 pub mod vector;
 #[cfg(feature = "rerun")]
@@ -57,6 +60,7 @@ pub use glam;
 pub use kind::{
     default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx,
 };
+pub use method::Method;
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;

@@ -45,6 +45,18 @@ impl AnyWorld {
     pub fn step_count(&self) -> u64 {
         both!(self, w => w.step_count())
     }
+    /// The collision method.
+    pub fn method(&self) -> crate::method::Method {
+        both!(self, w => w.method())
+    }
+    /// Changes the collision method.
+    pub fn set_method(&mut self, m: crate::method::Method) -> Result<(), Error> {
+        both!(self, w => w.set_method(m))
+    }
+    /// What `auto` chose for the last step, and why.
+    pub fn auto_choice(&self) -> Option<(crate::method::Method, String)> {
+        both!(self, w => w.auto_choice().cloned())
+    }
     /// Simulated time.
     pub fn time(&self) -> f64 {
         both!(self, w => w.time())

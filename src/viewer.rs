@@ -130,10 +130,17 @@ impl RerunSink {
     fn static_2d(&mut self, w: &World<glam::DVec2>) {
         let t = w.topology();
         let (lo, hi) = (f32x2(t.min), f32x2(t.max));
-        let border = vec![[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]], [lo[0], lo[1]]];
-        let _ = self
-            .rec
-            .log_static("world/border", &rerun::LineStrips2D::new([border]).with_colors([[120, 120, 120]]));
+        let border = vec![
+            [lo[0], lo[1]],
+            [hi[0], lo[1]],
+            [hi[0], hi[1]],
+            [lo[0], hi[1]],
+            [lo[0], lo[1]],
+        ];
+        let _ = self.rec.log_static(
+            "world/border",
+            &rerun::LineStrips2D::new([border]).with_colors([[120, 120, 120]]),
+        );
         let mut outlines = Vec::new();
         for c in w.critters().iter() {
             if let Some(wall) = c.wall() {
@@ -141,13 +148,20 @@ impl RerunSink {
                     let local = glam::DVec2::new(sx * wall.half.x, sy * wall.half.y);
                     f32x2(c.pos + glam::DVec2::from_local(&wall.frame, local))
                 };
-                outlines.push(vec![corner(-1., -1.), corner(1., -1.), corner(1., 1.), corner(-1., 1.), corner(-1., -1.)]);
+                outlines.push(vec![
+                    corner(-1., -1.),
+                    corner(1., -1.),
+                    corner(1., 1.),
+                    corner(-1., 1.),
+                    corner(-1., -1.),
+                ]);
             }
         }
         if !outlines.is_empty() {
-            let _ = self
-                .rec
-                .log_static("world/walls", &rerun::LineStrips2D::new(outlines).with_colors([[90, 90, 90]]));
+            let _ = self.rec.log_static(
+                "world/walls",
+                &rerun::LineStrips2D::new(outlines).with_colors([[90, 90, 90]]),
+            );
         }
     }
 
@@ -165,7 +179,9 @@ impl RerunSink {
                 centers.push(f32x3(c.pos));
                 halves.push(f32x3(wall.half));
                 let q = glam::DQuat::from_mat3(&wall.frame);
-                rotations.push(rerun::Quaternion::from_xyzw([q.x as f32, q.y as f32, q.z as f32, q.w as f32]));
+                rotations.push(rerun::Quaternion::from_xyzw([
+                    q.x as f32, q.y as f32, q.z as f32, q.w as f32,
+                ]));
             }
         }
         if !centers.is_empty() {
@@ -195,9 +211,16 @@ impl RerunSink {
         let kinds = w.kinds();
         // Group critters by kind, in id order.
         let mut by_kind: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-        let critters: Vec<_> = w.critters().iter().filter(|c| c.is_alive() && !c.is_wall()).collect();
+        let critters: Vec<_> = w
+            .critters()
+            .iter()
+            .filter(|c| c.is_alive() && !c.is_wall())
+            .collect();
         for (i, c) in critters.iter().enumerate() {
-            by_kind.entry(kinds.name(c.kind()).to_string()).or_default().push(i);
+            by_kind
+                .entry(kinds.name(c.kind()).to_string())
+                .or_default()
+                .push(i);
         }
         // Kinds that have died out are cleared, so they do not linger.
         for name in self.kinds_seen.keys() {
@@ -209,8 +232,14 @@ impl RerunSink {
         for (name, members) in &by_kind {
             self.kinds_seen.insert(name.clone(), ());
             let kind_id = critters[members[0]].kind();
-            let color = color_of(kinds.get(kind_id).defaults.color.as_deref(), kind_id.0 as usize);
-            let radii: Vec<f32> = members.iter().map(|&i| critters[i].radius() as f32).collect();
+            let color = color_of(
+                kinds.get(kind_id).defaults.color.as_deref(),
+                kind_id.0 as usize,
+            );
+            let radii: Vec<f32> = members
+                .iter()
+                .map(|&i| critters[i].radius() as f32)
+                .collect();
             let labels: Vec<String> = if self.labels {
                 members
                     .iter()
@@ -222,30 +251,39 @@ impl RerunSink {
             let path = format!("world/critters/{name}");
             if V::DIM == 2 {
                 let pos: Vec<[f32; 2]> = members.iter().map(|&i| f32x2(critters[i].pos)).collect();
-                let mut points = rerun::Points2D::new(pos.clone()).with_radii(radii).with_colors([color]);
+                let mut points = rerun::Points2D::new(pos.clone())
+                    .with_radii(radii)
+                    .with_colors([color]);
                 if self.labels {
                     points = points.with_labels(labels);
                 }
                 let _ = rec.log(path, &points);
                 if self.arrows {
-                    let vel: Vec<[f32; 2]> = members.iter().map(|&i| f32x2(critters[i].vel)).collect();
+                    let vel: Vec<[f32; 2]> =
+                        members.iter().map(|&i| f32x2(critters[i].vel)).collect();
                     let _ = rec.log(
                         format!("world/velocities/{name}"),
-                        &rerun::Arrows2D::from_vectors(vel).with_origins(pos).with_colors([color]),
+                        &rerun::Arrows2D::from_vectors(vel)
+                            .with_origins(pos)
+                            .with_colors([color]),
                     );
                 }
             } else {
                 let pos: Vec<[f32; 3]> = members.iter().map(|&i| f32x3(critters[i].pos)).collect();
-                let mut spheres = rerun::Ellipsoids3D::from_centers_and_radii(pos.clone(), radii).with_colors([color]);
+                let mut spheres = rerun::Ellipsoids3D::from_centers_and_radii(pos.clone(), radii)
+                    .with_colors([color]);
                 if self.labels {
                     spheres = spheres.with_labels(labels);
                 }
                 let _ = rec.log(path, &spheres);
                 if self.arrows {
-                    let vel: Vec<[f32; 3]> = members.iter().map(|&i| f32x3(critters[i].vel)).collect();
+                    let vel: Vec<[f32; 3]> =
+                        members.iter().map(|&i| f32x3(critters[i].vel)).collect();
                     let _ = rec.log(
                         format!("world/velocities/{name}"),
-                        &rerun::Arrows3D::from_vectors(vel).with_origins(pos).with_colors([color]),
+                        &rerun::Arrows3D::from_vectors(vel)
+                            .with_origins(pos)
+                            .with_colors([color]),
                     );
                 }
             }
@@ -257,32 +295,71 @@ impl RerunSink {
             let _ = rec.log("world/contacts", &rerun::Clear::flat());
         } else if V::DIM == 2 {
             let points: Vec<[f32; 2]> = events.collisions.iter().map(|e| f32x2(e.point)).collect();
-            let impulses: Vec<[f32; 2]> = events.collisions.iter().map(|e| f32x2(e.normal * e.impulse)).collect();
-            let _ = rec.log("world/contacts", &rerun::Arrows2D::from_vectors(impulses).with_origins(points).with_colors([[230, 60, 60]]));
+            let impulses: Vec<[f32; 2]> = events
+                .collisions
+                .iter()
+                .map(|e| f32x2(e.normal * e.impulse))
+                .collect();
+            let _ = rec.log(
+                "world/contacts",
+                &rerun::Arrows2D::from_vectors(impulses)
+                    .with_origins(points)
+                    .with_colors([[230, 60, 60]]),
+            );
         } else {
             let points: Vec<[f32; 3]> = events.collisions.iter().map(|e| f32x3(e.point)).collect();
-            let impulses: Vec<[f32; 3]> = events.collisions.iter().map(|e| f32x3(e.normal * e.impulse)).collect();
-            let _ = rec.log("world/contacts", &rerun::Arrows3D::from_vectors(impulses).with_origins(points).with_colors([[230, 60, 60]]));
+            let impulses: Vec<[f32; 3]> = events
+                .collisions
+                .iter()
+                .map(|e| f32x3(e.normal * e.impulse))
+                .collect();
+            let _ = rec.log(
+                "world/contacts",
+                &rerun::Arrows3D::from_vectors(impulses)
+                    .with_origins(points)
+                    .with_colors([[230, 60, 60]]),
+            );
         }
         let describe = |id: CritterId| format!("critter {id}");
         for id in &events.spawns {
-            let _ = rec.log("log", &rerun::TextLog::new(format!("spawned {}", describe(*id))).with_level("INFO"));
+            let _ = rec.log(
+                "log",
+                &rerun::TextLog::new(format!("spawned {}", describe(*id))).with_level("INFO"),
+            );
         }
         for id in &events.deaths {
-            let _ = rec.log("log", &rerun::TextLog::new(format!("{} died", describe(*id))).with_level("WARN"));
+            let _ = rec.log(
+                "log",
+                &rerun::TextLog::new(format!("{} died", describe(*id))).with_level("WARN"),
+            );
         }
         for line in &events.log {
-            let _ = rec.log("log", &rerun::TextLog::new(line.clone()).with_level("DEBUG"));
+            let _ = rec.log(
+                "log",
+                &rerun::TextLog::new(line.clone()).with_level("DEBUG"),
+            );
         }
 
         // Totals.
         let p = w.momentum().to_array3();
-        let _ = rec.log("stats/kinetic_energy", &rerun::Scalars::single(w.kinetic_energy()));
+        let _ = rec.log(
+            "stats/kinetic_energy",
+            &rerun::Scalars::single(w.kinetic_energy()),
+        );
         for (axis, name) in ["x", "y", "z"].iter().enumerate().take(V::DIM) {
-            let _ = rec.log(format!("stats/momentum/{name}"), &rerun::Scalars::single(p[axis]));
+            let _ = rec.log(
+                format!("stats/momentum/{name}"),
+                &rerun::Scalars::single(p[axis]),
+            );
         }
-        let _ = rec.log("stats/collisions", &rerun::Scalars::single(w.stats().collisions as f64));
-        let _ = rec.log("stats/step_ms", &rerun::Scalars::single(step_time.as_secs_f64() * 1e3));
+        let _ = rec.log(
+            "stats/collisions",
+            &rerun::Scalars::single(w.stats().collisions as f64),
+        );
+        let _ = rec.log(
+            "stats/step_ms",
+            &rerun::Scalars::single(step_time.as_secs_f64() * 1e3),
+        );
     }
 
     /// Flushes what is buffered. For a live viewer, waits at most a few seconds and returns a

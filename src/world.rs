@@ -24,8 +24,9 @@ use crate::critter::{
 };
 use crate::critter_set::CritterSet;
 use crate::error::Error;
-use crate::hash::StateHasher;
+use crate::hash::{pair, StateHasher};
 use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
+use crate::method::Method;
 use crate::rng::Rng;
 use crate::rules::{PairRule, RuleCache};
 use crate::vector::Vector;
@@ -55,6 +56,8 @@ pub struct WorldConfig<V: Vector> {
     pub seed: u64,
     /// Broad-phase algorithm.
     pub broad_phase: BroadPhaseMode,
+    /// Collision method (see [`crate::method`]).
+    pub method: Method,
 }
 
 impl<V: Vector> WorldConfig<V> {
@@ -68,7 +71,13 @@ impl<V: Vector> WorldConfig<V> {
             dt: 1.0 / 60.0,
             seed: 0,
             broad_phase: BroadPhaseMode::Auto,
+            method: Method::Discrete,
         }
+    }
+    /// With collision method `m`.
+    pub fn method(mut self, m: Method) -> Self {
+        self.method = m;
+        self
     }
     /// With border `b`.
     pub fn border(mut self, b: Border) -> Self {
@@ -164,6 +173,12 @@ pub struct StepStats {
     pub collisions: usize,
     /// Default collisions that exchanged an impulse (approaching pairs).
     pub impacts: usize,
+    /// Events processed by the swept and event methods (collisions, wall and border hits, cell
+    /// crossings).
+    pub events: u64,
+    /// Steps in which the swept or event method ran out of its event budget and finished the
+    /// step with a discrete pass (see `docs/methods.md`).
+    pub budget_exceeded: u64,
 }
 
 impl StepStats {
@@ -192,33 +207,39 @@ impl StepStats {
         self.contacts += o.contacts;
         self.collisions += o.collisions;
         self.impacts += o.impacts;
+        self.events += o.events;
+        self.budget_exceeded += o.budget_exceeded;
     }
 }
 
 /// A world of critters in 2D (`World<DVec2>`) or 3D (`World<DVec3>`).
 pub struct World<V: Vector> {
-    topo: Topology<V>,
-    gravity: V,
-    dt: f64,
-    seed: u64,
-    critters: CritterSet<V>,
-    kinds: KindSet<V>,
-    rules: RuleCache,
-    broad: BroadPhase<V>,
-    walls: Vec<CritterId>,
-    rng: Rng,
-    step_count: u64,
-    pending: Pending<V>,
-    events: StepEvents<V>,
-    stats: StepStats,
-    totals: StepStats,
-    objs: Vec<BroadObject<V>>,
-    candidates: Vec<(u32, u32)>,
+    pub(crate) topo: Topology<V>,
+    pub(crate) gravity: V,
+    pub(crate) dt: f64,
+    pub(crate) seed: u64,
+    pub(crate) critters: CritterSet<V>,
+    pub(crate) kinds: KindSet<V>,
+    pub(crate) rules: RuleCache,
+    pub(crate) broad: BroadPhase<V>,
+    pub(crate) walls: Vec<CritterId>,
+    pub(crate) rng: Rng,
+    pub(crate) step_count: u64,
+    pub(crate) pending: Pending<V>,
+    pub(crate) events: StepEvents<V>,
+    pub(crate) stats: StepStats,
+    pub(crate) totals: StepStats,
+    pub(crate) objs: Vec<BroadObject<V>>,
+    pub(crate) candidates: Vec<(u32, u32)>,
     /// (caller, arg, roles still to ask the hooks for)
-    ruled: Vec<(u32, u32, bool)>,
-    contacts: Vec<(u32, u32)>,
+    pub(crate) ruled: Vec<(u32, u32, bool)>,
+    pub(crate) contacts: Vec<(u32, u32)>,
     /// Candidate pairs with a wall: (first, second, roles still to ask the hooks for).
-    wall_pairs: Vec<(u32, u32, bool)>,
+    pub(crate) wall_pairs: Vec<(u32, u32, bool)>,
+    pub(crate) method: Method,
+    /// What `auto` chose for the last step, and why.
+    pub(crate) auto_choice: Option<(Method, String)>,
+    pub(crate) flight: crate::method::flight::Scratch<V>,
 }
 
 impl<V: Vector> World<V> {
@@ -250,6 +271,9 @@ impl<V: Vector> World<V> {
             ruled: Vec::new(),
             contacts: Vec::new(),
             wall_pairs: Vec::new(),
+            method: config.method,
+            auto_choice: None,
+            flight: Default::default(),
         })
     }
 
@@ -274,6 +298,31 @@ impl<V: Vector> World<V> {
         }
         self.dt = dt;
         Ok(())
+    }
+    /// The collision method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+    /// Changes the collision method (takes effect at the next step).
+    pub fn set_method(&mut self, m: Method) -> Result<(), Error> {
+        if let Method::Substep(n) = m {
+            if !(1..=crate::method::MAX_SUBSTEPS).contains(&n) {
+                return Err(Error::InvalidWorld {
+                    field: "method",
+                    value: m.to_string(),
+                    reason: format!(
+                        "the substep count must be from 1 to {}",
+                        crate::method::MAX_SUBSTEPS
+                    ),
+                });
+            }
+        }
+        self.method = m;
+        Ok(())
+    }
+    /// For `auto`: the method chosen for the last step and the reason (None for other methods).
+    pub fn auto_choice(&self) -> Option<&(Method, String)> {
+        self.auto_choice.as_ref()
     }
     /// Gravity.
     pub fn gravity(&self) -> V {
@@ -374,8 +423,16 @@ impl<V: Vector> World<V> {
     }
 
     /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
-    /// overwhelming probability) bit-identical worlds.
+    /// overwhelming probability) bit-identical worlds. It covers the step count, dt, the
+    /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
+    /// radius, mass, priority, restitution, health and properties.
     pub fn state_hash(&self) -> u64 {
+        self.state_hash_visiting(|_| {})
+    }
+
+    /// [`World::state_hash`], calling `visit` on each critter (in slot order) in the same pass,
+    /// so a recorder can sum its totals without walking the critters a second time.
+    pub fn state_hash_visiting(&self, mut visit: impl FnMut(&Critter<V>)) -> u64 {
         let mut h = StateHasher::default();
         h.word(self.step_count);
         h.float(self.dt);
@@ -383,17 +440,24 @@ impl<V: Vector> World<V> {
             h.word(w);
         }
         for c in self.critters.iter() {
-            h.word(((c.id.index as u64) << 32) | c.id.generation as u64);
-            h.word(((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64);
-            for axis in 0..V::DIM {
-                h.float(c.pos.get(axis));
-                h.float(c.vel.get(axis));
-            }
-            h.float(c.radius);
-            h.float(c.mass);
-            h.float(c.priority);
-            h.float(c.restitution);
-            h.float(c.health);
+            visit(c);
+            let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
+            let flags = ((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64;
+            let (z, vz) = if V::DIM == 3 {
+                (c.pos.get(2), c.vel.get(2))
+            } else {
+                (0.0, 0.0)
+            };
+            h.words([
+                id,
+                flags ^ (c.props.len() as u64).rotate_left(40),
+                pair(c.pos.get(0), c.pos.get(1)),
+                pair(c.vel.get(0), c.vel.get(1)),
+                pair(c.radius, c.mass),
+                pair(c.priority, c.restitution),
+                pair(c.health, z),
+                vz.to_bits(),
+            ]);
             for (name, value) in &c.props {
                 hash_bytes(&mut h, name.as_bytes());
                 hash_prop(&mut h, value);
@@ -629,34 +693,29 @@ impl<V: Vector> World<V> {
     pub fn step(&mut self) -> Result<(), Error> {
         self.events.clear();
         self.stats = StepStats::default();
-        let mut clock = Instant::now();
-        let mut lap = |slot: &mut Duration| {
-            let now = Instant::now();
-            *slot = now - clock;
-            clock = now;
-        };
         let mut stats = StepStats::default();
 
+        let clock = Instant::now();
         self.stage_update()?;
-        lap(&mut stats.update);
-        self.stage_move();
-        lap(&mut stats.moving);
-        self.stage_broad_phase();
-        lap(&mut stats.broad_phase);
-        self.stage_rules()?;
-        lap(&mut stats.rules);
-        self.stage_narrow_phase()?;
-        lap(&mut stats.narrow_phase);
-        let collisions = self.stage_response()?;
-        lap(&mut stats.response);
+        stats.update = clock.elapsed();
+        let method = match self.method {
+            Method::Auto => {
+                let (m, why) = crate::method::auto::choose(self);
+                self.auto_choice = Some((m, why));
+                m
+            }
+            m => m,
+        };
+        match method {
+            Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
+            Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
+            Method::Swept => crate::method::swept::step(self, &mut stats)?,
+            Method::Event => crate::method::event::step(self, &mut stats)?,
+        }
+        let clock = Instant::now();
         self.stage_lifecycle()?;
-        lap(&mut stats.lifecycle);
+        stats.lifecycle = clock.elapsed();
 
-        stats.pair_tests = self.broad.tests;
-        stats.candidates = self.candidates.len();
-        stats.ruled = self.ruled.len();
-        stats.contacts = self.contacts.len();
-        stats.collisions = collisions;
         stats.impacts = self
             .events
             .collisions
@@ -666,6 +725,43 @@ impl<V: Vector> World<V> {
         self.stats = stats;
         self.totals.add(&stats);
         self.step_count += 1;
+        Ok(())
+    }
+
+    /// Pop's step without the update hooks and lifecycle: `n` times move by dt/n, broad phase,
+    /// rules, narrow phase, response.
+    pub(crate) fn discrete_substeps(&mut self, n: u32, stats: &mut StepStats) -> Result<(), Error> {
+        let h = self.dt / n as f64;
+        for _ in 0..n {
+            let clock = Instant::now();
+            self.stage_move(h);
+            stats.moving += clock.elapsed();
+            self.discrete_collide(stats)?;
+        }
+        Ok(())
+    }
+
+    /// Broad phase, rules, narrow phase and response where the critters are now.
+    pub(crate) fn discrete_collide(&mut self, stats: &mut StepStats) -> Result<(), Error> {
+        let mut clock = Instant::now();
+        let mut lap = |slot: &mut Duration| {
+            let now = Instant::now();
+            *slot += now - clock;
+            clock = now;
+        };
+        self.stage_broad_phase();
+        lap(&mut stats.broad_phase);
+        self.stage_rules()?;
+        lap(&mut stats.rules);
+        self.stage_narrow_phase()?;
+        lap(&mut stats.narrow_phase);
+        let collisions = self.stage_response()?;
+        lap(&mut stats.response);
+        stats.pair_tests += self.broad.tests;
+        stats.candidates += self.candidates.len();
+        stats.ruled += self.ruled.len();
+        stats.contacts += self.contacts.len();
+        stats.collisions += collisions;
         Ok(())
     }
 
@@ -703,8 +799,8 @@ impl<V: Vector> World<V> {
         Ok(())
     }
 
-    fn stage_move(&mut self) {
-        let (dt, g, topo) = (self.dt, self.gravity, self.topo);
+    fn stage_move(&mut self, dt: f64) {
+        let (g, topo) = (self.gravity, self.topo);
         let dv = g * dt;
         // Each critter moves on its own, so any split over threads gives the same bits.
         let step = |c: &mut Critter<V>| {
@@ -901,7 +997,7 @@ impl<V: Vector> World<V> {
     }
 
     /// Calls the caller's `collide` on a touching pair, if both are still alive.
-    fn collide_pair(&mut self, caller: u32, arg: u32) -> Result<bool, Error> {
+    pub(crate) fn collide_pair(&mut self, caller: u32, arg: u32) -> Result<bool, Error> {
         let (Some(c), Some(a)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
             return Ok(false);
         };
@@ -968,7 +1064,7 @@ impl<V: Vector> World<V> {
 }
 
 /// Sets the step of a hook error raised where the step was not known.
-fn at_step(e: Error, step: u64) -> Error {
+pub(crate) fn at_step(e: Error, step: u64) -> Error {
     match e {
         Error::Hook {
             kind,
@@ -990,7 +1086,7 @@ fn at_step(e: Error, step: u64) -> Error {
 }
 
 /// (caller, arg) for a pair under `rule`, or `None` when they don't collide.
-fn roles_order<'c, V: Vector>(
+pub(crate) fn roles_order<'c, V: Vector>(
     rule: PairRule,
     a: &'c Critter<V>,
     b: &'c Critter<V>,

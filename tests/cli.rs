@@ -5,6 +5,11 @@ use std::process::{Command, Output};
 fn critterbox(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_critterbox"))
         .args(args)
+        // Runs record by default: keep their recordings out of the source tree.
+        .env(
+            "CRITTERBOX_RECORDINGS",
+            std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-recordings"),
+        )
         .output()
         .expect("the critterbox binary runs")
 }
@@ -189,4 +194,55 @@ fn check_passes_shipped_scripts_and_fails_a_broken_one_with_its_line() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("broken.rhai:2:"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn every_method_runs_every_shipped_scene_script_and_calls_its_hooks() {
+    // bullets_vs_player: bullets' collide hooks kill them and damage players; under every method
+    // some bullets must have died (the hooks ran) and the run must succeed.
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scripts/scenes/bullets_vs_player.rhai"
+    );
+    for m in ["discrete", "substep:2", "swept", "event", "auto"] {
+        let o = critterbox(&["run", scene, "--steps", "200", "--method", m]);
+        assert!(o.status.success(), "{m}: {}", stderr(&o));
+        let out = stdout(&o);
+        assert_eq!(field(&out, "method"), m, "{out}");
+        assert!(field(&out, "critters").contains("bullet"), "{out}");
+    }
+    let o = critterbox(&["run", "gas", "--steps", "5", "--method", "auto"]);
+    assert!(
+        field(&stdout(&o), "auto chose").starts_with("discrete"),
+        "{}",
+        stdout(&o)
+    );
+}
+
+#[test]
+fn bad_methods_are_clear_errors() {
+    for bad in ["fast", "substep:0", "substep:x"] {
+        let o = critterbox(&["run", "gas", "--steps", "1", "--method", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(stderr(&o).contains("method"), "{}", stderr(&o));
+    }
+    let dir = std::env::temp_dir().join(format!("critterbox-method-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("m.rhai");
+    std::fs::write(&scene, "world(#{ method: \"warp\" });\n").expect("write");
+    let o = critterbox(&["run", scene.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("unknown method 'warp'"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::write(
+        &scene,
+        "world(#{ dim: 2, method: \"substep:3\" });\nspawn(\"ball\", #{ pos: vec(5, 5) });\n",
+    )
+    .expect("write");
+    let o = critterbox(&["run", scene.to_str().expect("utf-8"), "--steps", "3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(field(&stdout(&o), "method"), "substep:3");
 }

@@ -30,7 +30,12 @@ fn read_rrd(file: &Path, entity: &str, index: usize) -> (Vec<String>, usize, Vec
         String::from_utf8_lossy(&out.stderr)
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("the reader prints JSON");
-    let entities = v["entities"].as_array().expect("entities").iter().map(|e| e.as_str().expect("path").to_string()).collect();
+    let entities = v["entities"]
+        .as_array()
+        .expect("entities")
+        .iter()
+        .map(|e| e.as_str().expect("path").to_string())
+        .collect();
     let steps = v["steps"].as_u64().expect("steps") as usize;
     let track = v["track"]
         .as_array()
@@ -38,7 +43,12 @@ fn read_rrd(file: &Path, entity: &str, index: usize) -> (Vec<String>, usize, Vec
         .iter()
         .map(|p| {
             let step = p[0].as_i64().expect("step");
-            let xy = p[1].as_array().expect("point").iter().map(|x| x.as_f64().expect("coordinate")).collect();
+            let xy = p[1]
+                .as_array()
+                .expect("point")
+                .iter()
+                .map(|x| x.as_f64().expect("coordinate"))
+                .collect();
             (step, xy)
         })
         .collect();
@@ -53,15 +63,30 @@ fn a_saved_run_has_the_entities_steps_and_positions_of_the_run() {
     let scene = root().join("scripts/scenes/cradle.rhai");
     let steps = 90;
     let status = Command::new(env!("CARGO_BIN_EXE_critterbox"))
-        .args(["run", scene.to_str().expect("utf-8"), "--steps", &steps.to_string(), "--rerun-save"])
+        .args([
+            "run",
+            scene.to_str().expect("utf-8"),
+            "--steps",
+            &steps.to_string(),
+            "--rerun-save",
+        ])
         .arg(&rrd)
         .status()
         .expect("critterbox runs");
     assert!(status.success());
 
     let (entities, seen_steps, track) = read_rrd(&rrd, "/world/critters/ball", 5);
-    for path in ["/world/critters/ball", "/world/velocities/ball", "/world/contacts", "/stats/kinetic_energy", "/world/border"] {
-        assert!(entities.iter().any(|e| e == path), "{path} missing from {entities:?}");
+    for path in [
+        "/world/critters/ball",
+        "/world/velocities/ball",
+        "/world/contacts",
+        "/stats/kinetic_energy",
+        "/world/border",
+    ] {
+        assert!(
+            entities.iter().any(|e| e == path),
+            "{path} missing from {entities:?}"
+        );
     }
     // Step 0 (the start) and every step after it.
     assert_eq!(seen_steps, steps + 1);
@@ -71,7 +96,12 @@ fn a_saved_run_has_the_entities_steps_and_positions_of_the_run() {
     let mut scene = load_scene(&scene, &[], &ScriptOptions::default()).expect("the scene loads");
     let pos = |s: &critterbox::scenes::Scene| match &s.world {
         AnyWorld::D2(w) => {
-            let c = w.critters().iter().filter(|c| !c.is_wall()).nth(5).expect("six balls");
+            let c = w
+                .critters()
+                .iter()
+                .filter(|c| !c.is_wall())
+                .nth(5)
+                .expect("six balls");
             vec![c.pos.x as f32 as f64, c.pos.y as f32 as f64]
         }
         AnyWorld::D3(_) => unreachable!("the cradle is 2D"),

@@ -2,8 +2,16 @@
 //!
 //! `src/main.rs` parses, calls [`execute`], and turns the outcome into an exit code.
 
+pub mod chart;
 pub mod check;
+pub mod diff;
+pub mod export;
+pub mod inspect;
+pub mod record;
+pub mod recover;
+pub mod replay;
 pub mod run;
+pub mod stability;
 pub mod test;
 pub mod view;
 
@@ -27,6 +35,20 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Run script tests: every `fn test_*()` in scripts/tests/*.rhai.
     Test(test::TestArgs),
+    /// Play a recording back: a summary, any step's exact state, or a full re-simulation check.
+    Replay(replay::ReplayArgs),
+    /// Show what a recording holds: scene, critters, collisions, energy and momentum over time.
+    Inspect(inspect::InspectArgs),
+    /// Show the first step and critter where two recordings differ.
+    Diff(diff::DiffArgs),
+    /// Write a recording's states and events as CSV files.
+    Export(export::ExportArgs),
+    /// Make a readable, complete file from a cut-off recording (complete chunks kept).
+    Recover(recover::RecoverArgs),
+    /// Chart cost against error for every method; writes docs/speed-vs-accuracy.svg and .png.
+    Chart(chart::ChartArgs),
+    /// Run the stress scenes under every collision method and print the error table.
+    Stability(stability::StabilityArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
@@ -35,6 +57,13 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         Some(Command::Run(args)) => run::run(&args, out),
         Some(Command::Check(args)) => check::run(&args, out),
         Some(Command::Test(args)) => test::run(&args, out),
+        Some(Command::Replay(args)) => replay::run(&args, out),
+        Some(Command::Inspect(args)) => inspect::run(&args, out),
+        Some(Command::Diff(args)) => diff::run(&args, out),
+        Some(Command::Export(args)) => export::run(&args, out),
+        Some(Command::Recover(args)) => recover::run(&args, out),
+        Some(Command::Chart(args)) => chart::run(&args, out),
+        Some(Command::Stability(args)) => stability::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }

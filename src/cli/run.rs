@@ -1,5 +1,6 @@
 //! `critterbox run`: run a scene headless and print a summary.
 
+use super::record::{self, RecordArgs};
 use crate::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
 use crate::script::{Limits, ScriptOptions};
 use anyhow::Context;
@@ -50,12 +51,18 @@ pub struct RunArgs {
     /// Number of critters, for scenes that have a natural count (gas, cradle, pegs).
     #[arg(short = 'n', long)]
     pub n: Option<usize>,
+    /// Collision method: discrete, substep:N, swept, event or auto (default: the scene's own).
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<crate::method::Method>,
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
     /// Watching the run.
     #[command(flatten)]
     pub view: super::view::ViewArgs,
+    /// Recording options.
+    #[command(flatten)]
+    pub recording: RecordArgs,
 }
 
 /// Runs the command.
@@ -82,16 +89,27 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if let Some(dt) = args.dt {
         scene.world.set_dt(dt)?;
     }
+    if let Some(m) = args.method {
+        scene.world.set_method(m)?;
+    }
     let name = scene.name.clone();
     let steps = args.steps.unwrap_or(scene.default_steps);
 
     let energy0 = scene.world.kinetic_energy();
     let momentum0 = scene.world.momentum();
     let mut viewer = super::view::Viewer::open(&args.view, &scene.world)?;
+    // Recording: started before the first step, fed after each one, closed at the end.
+    let mut recorder = record::start(args, &scene, steps)?;
+    record::watch_ctrl_c();
+    let mut interrupted = false;
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
     for i in 0..steps {
+        if record::interrupted() {
+            interrupted = true;
+            break;
+        }
         let step = scene.world.step_count();
         let step_started = Instant::now();
         let outcome = scene.step();
@@ -104,7 +122,19 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
                 }
             });
         }
-        if let Some(reason) = outcome.with_context(|| format!("scene '{name}', step {step}"))? {
+        let outcome = match outcome.with_context(|| format!("scene '{name}', step {step}")) {
+            Ok(outcome) => outcome,
+            Err(e) => {
+                // The error goes into the recording, which is closed before it is reported.
+                bar.finish_and_clear();
+                record::fail(recorder.take(), &scene, &e, out)?;
+                return Err(e);
+            }
+        };
+        if let Some(r) = &mut recorder {
+            r.record(&scene.world)?;
+        }
+        if let Some(reason) = outcome {
             stopped = Some((scene.world.step_count(), reason));
             break;
         }
@@ -125,12 +155,35 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             100.0 * spent.as_secs_f64() / wall.as_secs_f64().max(1e-9)
         )?;
     }
-    if let Some((at, reason)) = stopped {
+    let method = scene.world.method();
+    writeln!(out, "method       {method}")?;
+    if let Some((chose, why)) = scene.world.auto_choice() {
+        writeln!(out, "auto chose   {chose} (last step): {why}")?;
+    }
+    let t = scene.world.totals();
+    if t.events > 0 || t.budget_exceeded > 0 {
+        writeln!(
+            out,
+            "events       {} processed, {} steps over budget",
+            t.events, t.budget_exceeded
+        )?;
+    }
+    if let Some((at, reason)) = &stopped {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
     if args.stats {
         stats(out, &scene.world, done)?;
     }
+    let (outcome, reason) = match (&stopped, interrupted) {
+        (_, true) => ("interrupted", "Ctrl-C".to_string()),
+        (Some((_, reason)), _) => ("stopped", reason.clone()),
+        _ => ("completed", String::new()),
+    };
+    record::finish(recorder, &scene, outcome, &reason, out)?;
+    anyhow::ensure!(
+        !interrupted,
+        "interrupted by Ctrl-C after step {done} (the recording is complete up to there)"
+    );
     Ok(())
 }
 
@@ -178,6 +231,10 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         &sets,
         &options,
     )?)
+}
+
+fn parse_method(s: &str) -> Result<crate::method::Method, String> {
+    s.parse()
 }
 
 fn progress_bar(steps: u64) -> ProgressBar {

@@ -27,6 +27,12 @@ pub struct TestArgs {
     /// Seconds one test may run before it fails.
     #[arg(long, default_value_t = 60)]
     pub timeout: u64,
+    /// Rewrite the golden recordings that tests compare with (`expect_matches_recording`).
+    #[arg(long)]
+    pub bless: bool,
+    /// Where failing tests' runs are recorded (default: recordings/test-failures; "none" to skip).
+    #[arg(long, value_name = "DIR")]
+    pub record_failures: Option<PathBuf>,
     /// Most operations one script call may run (endless-loop guard).
     #[arg(long, default_value_t = Limits::default().max_operations)]
     pub max_ops: u64,
@@ -57,6 +63,12 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         filter: args.filter.clone(),
         jobs: args.jobs.unwrap_or(TestOptions::default().jobs),
         timeout: Duration::from_secs(args.timeout),
+        record_failures: match &args.record_failures {
+            Some(dir) if dir.as_os_str() == "none" => None,
+            Some(dir) => Some(dir.clone()),
+            None => Some(crate::recording::path::default_dir().join("test-failures")),
+        },
+        bless: args.bless,
     };
     let mut report = |o: &TestOutcome| {
         let ms = o.duration.as_secs_f64() * 1e3;

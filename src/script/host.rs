@@ -231,6 +231,12 @@ pub(crate) struct Host {
     pub testing: Cell<bool>,
     /// A test's wall-clock deadline.
     pub deadline: Cell<Option<std::time::Instant>>,
+    /// The recording of a test's run (kept only if the test fails).
+    pub test_recorder: RefCell<Option<crate::recording::Recorder>>,
+    /// Where a test's run would be recorded; `None` records nothing.
+    pub test_record_path: RefCell<Option<std::path::PathBuf>>,
+    /// `critterbox test --bless`: golden recordings are rewritten, not compared.
+    pub bless: Cell<bool>,
     /// Set by `world.stop(reason)`.
     pub stop: RefCell<Option<String>>,
     /// Steps the scene asked for (`world(#{ steps: ... })`).
@@ -254,6 +260,9 @@ impl Host {
             scene_world: Cell::new(std::ptr::null_mut()),
             testing: Cell::new(false),
             deadline: Cell::new(None),
+            test_recorder: RefCell::new(None),
+            test_record_path: RefCell::new(None),
+            bless: Cell::new(false),
             stop: RefCell::new(None),
             scene_steps: Cell::new(None),
             seed_override: Cell::new(None),

@@ -71,12 +71,10 @@ fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
                 )?
             }
             "method" => {
-                let m = value.to_string();
-                if m != "discrete" {
-                    return fail(format!(
-                        "method '{m}' is not available yet: the engine has the discrete method only (method: \"discrete\")"
-                    ));
-                }
+                config.method = value
+                    .to_string()
+                    .parse::<crate::method::Method>()
+                    .map_or_else(fail, Ok)?;
             }
             "steps" => {
                 steps = Some(value.as_int().ok().filter(|s| *s >= 0).map_or_else(
@@ -142,6 +140,9 @@ fn make_world(host: &Rc<Host>, map: &Map) -> Res<WorldRef> {
     };
     host.scene_steps.set(steps);
     host.put_scene(Scene::new("world", any, steps.unwrap_or(600)));
+    if host.testing.get() {
+        super::testing::start_recording_pub(host)?;
+    }
     Ok(WorldRef)
 }
 

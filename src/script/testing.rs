@@ -57,6 +57,10 @@ pub struct TestOptions {
     pub jobs: usize,
     /// Wall-clock limit per test.
     pub timeout: Duration,
+    /// Record each test's run here (`<dir>/<file>-<test>.mcap`), kept only when it fails.
+    pub record_failures: Option<PathBuf>,
+    /// Rewrite golden recordings instead of comparing with them.
+    pub bless: bool,
 }
 
 impl Default for TestOptions {
@@ -66,6 +70,8 @@ impl Default for TestOptions {
             filter: None,
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             timeout: Duration::from_secs(60),
+            record_failures: None,
+            bless: false,
         }
     }
 }
@@ -155,6 +161,16 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
     }
     rt.host.testing.set(true);
     rt.host.deadline.set(Some(Instant::now() + options.timeout));
+    rt.host.bless.set(options.bless);
+    let record_path = options.record_failures.as_ref().map(|dir| {
+        let stem = case
+            .file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        dir.join(format!("{stem}-{}.mcap", case.name))
+    });
+    *rt.host.test_record_path.borrow_mut() = record_path.clone();
     let mut scope = Scope::new();
     let result = rt.engine.call_fn_with_options::<Dynamic>(
         rhai::CallFnOptions::new(),
@@ -164,6 +180,34 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
         (),
     );
     let scene = rt.host.take_scene();
+    let recorder = rt.host.test_recorder.borrow_mut().take();
+    let kept = match (recorder, &scene, &result) {
+        (Some(rec), Some(scene), Err(e)) => {
+            let end = crate::recording::EndMeta {
+                steps: scene.world.step_count(),
+                outcome: "error".into(),
+                reason: e.to_string(),
+                hash: scene.world.state_hash(),
+            };
+            rec.finish(&scene.world, end)
+                .ok()
+                .map(|w| w.path.display().to_string())
+        }
+        (Some(rec), Some(scene), Ok(_)) => {
+            // Passed: the run is not kept.
+            let path = rec.path().to_path_buf();
+            let end = crate::recording::EndMeta {
+                steps: scene.world.step_count(),
+                outcome: "completed".into(),
+                reason: String::new(),
+                hash: scene.world.state_hash(),
+            };
+            drop(rec.finish(&scene.world, end));
+            let _ = std::fs::remove_file(path);
+            None
+        }
+        _ => None,
+    };
     result.map(drop).map_err(|e| {
         let mut err = rt.host.locate(&e, || {
             eval_error(
@@ -176,6 +220,13 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
         });
         if err.step.is_none() {
             err.step = scene.as_ref().map(|s| s.world.step_count());
+        }
+        if let Some(path) = kept {
+            let replay = format!("the run is recorded: critterbox replay {path}");
+            err.hint = Some(match err.hint.take() {
+                Some(h) => format!("{h}\n  {replay}"),
+                None => replay,
+            });
         }
         Error::from(err)
     })
@@ -279,6 +330,9 @@ fn step_scene(host: &Host, n: INT) -> Res<()> {
     for _ in 0..n.max(0) {
         check_deadline(host)?;
         let (step, outcome) = with_scene(host, |scene| (scene.world.step_count(), scene.step()))?;
+        if outcome.is_ok() {
+            record_step(host)?;
+        }
         match outcome {
             Ok(None) => {}
             Ok(Some(_reason)) => return Ok(()),
@@ -286,6 +340,115 @@ fn step_scene(host: &Host, n: INT) -> Res<()> {
         }
     }
     Ok(())
+}
+
+/// Starts recording a test's inline world (see [`start_recording`]).
+pub(crate) fn start_recording_pub(host: &Host) -> Res<()> {
+    start_recording(host)
+}
+
+/// Starts recording the test's scene, if failures are to be recorded.
+fn start_recording(host: &Host) -> Res<()> {
+    let Some(path) = host.test_record_path.borrow().clone() else {
+        return Ok(());
+    };
+    let rec = with_scene(host, |scene| {
+        let meta = crate::cli::record::run_meta(
+            &crate::cli::run::RunArgs::default(),
+            scene,
+            scene.default_steps,
+        );
+        crate::recording::Recorder::create(&path, &meta, &scene.sources, &scene.world)
+    })?;
+    match rec {
+        Ok(rec) => *host.test_recorder.borrow_mut() = Some(rec),
+        // Not being able to record is not the test's failure; say so and go on.
+        Err(e) => eprintln!(
+            "warning: cannot record the test's run at {}: {e}",
+            path.display()
+        ),
+    }
+    Ok(())
+}
+
+fn record_step(host: &Host) -> Res<()> {
+    let mut slot = host.test_recorder.borrow_mut();
+    if let Some(rec) = slot.as_mut() {
+        let failed = with_scene(host, |scene| rec.record(&scene.world).is_err())?;
+        if failed {
+            *slot = None; // stop recording; the test itself goes on
+        }
+    }
+    Ok(())
+}
+
+/// `expect_matches_recording(path)`: the run from here matches the golden recording's state
+/// hash at every step; with `--bless`, the run is recorded as the new golden file instead.
+fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
+    let file = PathBuf::from(path);
+    if host.bless.get() {
+        let steps = with_scene(host, |s| s.default_steps)?;
+        let rec = with_scene(host, |scene| {
+            let mut meta =
+                crate::cli::record::run_meta(&crate::cli::run::RunArgs::default(), scene, steps);
+            // Only the hashes are compared: full states at the start and the end keep it small.
+            meta.record_every = steps.max(1);
+            crate::recording::Recorder::create(&file, &meta, &scene.sources, &scene.world)
+        })?;
+        let mut rec = rec.map_or_else(
+            |e| fail(format!("cannot write the golden recording {path}: {e}")),
+            Ok,
+        )?;
+        while with_scene(host, |s| s.world.step_count())? < steps {
+            check_deadline(host)?;
+            let stop = with_scene(host, |s| s.step())?
+                .map_err(|e| super::api::fail::<()>(flat(&e)).unwrap_err())?;
+            with_scene(host, |s| rec.record(&s.world))?.map_or_else(|e| fail(e.to_string()), Ok)?;
+            if stop.is_some() {
+                break;
+            }
+        }
+        with_scene(host, |s| {
+            let end = crate::recording::EndMeta {
+                steps: s.world.step_count(),
+                outcome: "completed".into(),
+                reason: String::new(),
+                hash: s.world.state_hash(),
+            };
+            rec.finish(&s.world, end)
+        })?
+        .map_or_else(|e| fail(e.to_string()), Ok)?;
+        return Ok(());
+    }
+    let golden = crate::recording::Recording::open(&file).map_or_else(
+        |e| fail(format!("cannot read the golden recording {path}: {e:#} (make it with `critterbox test --bless`)")),
+        Ok,
+    )?;
+    let Some(&last) = golden.hashes.keys().next_back() else {
+        return fail(format!("the golden recording {path} holds no steps"));
+    };
+    loop {
+        let (step, hash) = with_scene(host, |s| (s.world.step_count(), s.world.state_hash()))?;
+        if let Some(&want) = golden.hashes.get(&step) {
+            if want != hash {
+                return fail(format!(
+                    "the run differs from {path} at step {step} (state hash {hash:016x}, recorded {want:016x}); if the change is intended, rerun with --bless"
+                ));
+            }
+        }
+        if step >= last {
+            return Ok(());
+        }
+        check_deadline(host)?;
+        let stop = with_scene(host, |s| s.step())?
+            .map_err(|e| super::api::fail::<()>(flat(&e)).unwrap_err())?;
+        if stop.is_some() && step + 1 < last {
+            return fail(format!(
+                "the scene stopped at step {} but {path} goes on to step {last}",
+                step + 1
+            ));
+        }
+    }
 }
 
 fn flat(e: &Error) -> String {
@@ -489,6 +652,10 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
         }
     });
     let h = host.clone();
+    engine.register_fn("expect_matches_recording", move |path: &str| -> Res<()> {
+        expect_matches_recording(&h, path)
+    });
+    let h = host.clone();
     engine.register_fn("expect_collision", move |a: CritterRef, b: CritterRef, within: INT| -> Res<INT> {
         let start = step_count(&h);
         let (da, db) = (describe(&h, a), describe(&h, b));
@@ -542,5 +709,6 @@ fn load_scene(host: &Rc<Host>, path: &str, sets: &Map) -> Res<WorldRef> {
     let scene = super::load_scene(&p, &sets, &options)
         .map_err(|e| super::api::fail::<()>(flat(&e)).unwrap_err())?;
     host.put_scene(scene);
+    start_recording(host)?;
     Ok(WorldRef)
 }

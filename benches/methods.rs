@@ -1,0 +1,105 @@
+//! The event method's throughput and exactness (`docs/methods.md` reports the figures):
+//!
+//! * collisions per second, 2D gas of 10,000 disks at packing fraction 0.4 in a periodic box;
+//! * the same for 32,000 spheres at packing fraction 0.40 (Smallenburg's system), with the
+//!   compressibility factor from the collision virial (literature: about 6.91);
+//! * kinetic-energy drift over 1e6 collisions at e = 1.
+//!
+//! `cargo bench --bench methods` runs criterion (throughput in collisions/s);
+//! `CRITTERBOX_REPORT=1 cargo bench --bench methods` prints the report instead.
+
+use criterion::{Criterion, Throughput};
+use critterbox::glam::{DVec2, DVec3};
+use critterbox::scenes::{gas, GasParams};
+use critterbox::{Border, Method, Vector, World};
+use std::time::{Duration, Instant};
+
+fn periodic_gas<V: Vector>(n: usize, packing: f64, dt: f64) -> World<V> {
+    let mut w = gas::<V>(&GasParams {
+        n,
+        packing,
+        dt,
+        border: Border::Wrap,
+        ..GasParams::default()
+    })
+    .expect("the gas builds");
+    w.set_method(Method::Event).expect("event");
+    w
+}
+
+/// Runs until `collisions` impacts; returns (impacts, seconds, relative energy drift, Z).
+fn measure<V: Vector>(w: &mut World<V>, collisions: usize) -> (usize, f64, f64, f64) {
+    let e0 = w.kinetic_energy();
+    let n = w.critters().len() as f64;
+    let mut virial = 0.0;
+    let mut impacts = 0;
+    let t0 = w.time();
+    let start = Instant::now();
+    while impacts < collisions {
+        w.step().expect("steps");
+        impacts += w.stats().impacts;
+        virial += w.collision_virial();
+        assert_eq!(w.stats().budget_exceeded, 0, "event budget ran out");
+    }
+    let secs = start.elapsed().as_secs_f64();
+    let t = w.totals();
+    println!(
+        "  per collision: {:.2} events, {:.2} predictions, {:.1} pair tests",
+        t.events as f64 / t.impacts as f64,
+        t.candidates as f64 / t.impacts as f64,
+        t.pair_tests as f64 / t.impacts as f64
+    );
+    let e = w.kinetic_energy();
+    let d = V::DIM as f64;
+    let kt = 2.0 * e / (d * n); // kT = (2/D) x mean kinetic energy (unit masses scaled out)
+    let t = w.time() - t0;
+    let z = 1.0 + virial / (d * n * kt * t);
+    (impacts, secs, (e - e0) / e0, z)
+}
+
+fn report() {
+    // Warm up: relax from the grid start before measuring.
+    let mut g2 = periodic_gas::<DVec2>(10_000, 0.4, 5.0);
+    g2.run(1).expect("warm up");
+    let (c, s, drift, z) = measure(&mut g2, 2_000_000);
+    println!(
+        "2D 10,000 disks, phi 0.4, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4}",
+        c as f64 / s
+    );
+    let mut g3 = periodic_gas::<DVec3>(32_000, 0.4, 5.0);
+    g3.run(1).expect("warm up");
+    let (c, s, drift, z) = measure(&mut g3, 2_000_000);
+    println!(
+        "3D 32,000 spheres, phi 0.40, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4} (literature 6.91)",
+        c as f64 / s
+    );
+}
+
+fn main() {
+    if std::env::var_os("CRITTERBOX_REPORT").is_some() {
+        report();
+        return;
+    }
+    let mut c = Criterion::default()
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(5))
+        .configure_from_args();
+    let mut group = c.benchmark_group("event");
+    let mut g2 = periodic_gas::<DVec2>(10_000, 0.4, 0.2);
+    g2.run(10).expect("warm up");
+    g2.step().expect("step");
+    group.throughput(Throughput::Elements(g2.stats().impacts as u64));
+    group.bench_function("gas2d_10k_phi0.4_step0.2", |b| {
+        b.iter(|| g2.step().expect("step"))
+    });
+    let mut g3 = periodic_gas::<DVec3>(32_000, 0.4, 0.05);
+    g3.run(4).expect("warm up");
+    g3.step().expect("step");
+    group.throughput(Throughput::Elements(g3.stats().impacts as u64));
+    group.bench_function("gas3d_32k_phi0.4_step0.05", |b| {
+        b.iter(|| g3.step().expect("step"))
+    });
+    group.finish();
+    c.final_summary();
+}

@@ -1,0 +1,134 @@
+//! `critterbox chart`: cost against error for every method over a sweep of dt, written as
+//! `docs/speed-vs-accuracy.svg` and `.png` (see the README for how to read it). Text is laid out
+//! with a TrueType font (`--font`), for both files.
+
+use crate::method::Method;
+use crate::stability::{chart_points, ChartPoint};
+use anyhow::Context;
+use clap::Args;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `critterbox chart`.
+#[derive(Args, Debug)]
+pub struct ChartArgs {
+    /// Output path without extension: writes PATH.svg and PATH.png.
+    #[arg(long, default_value = "docs/speed-vs-accuracy")]
+    pub out: PathBuf,
+    /// A TrueType font for the chart's text.
+    #[arg(
+        long,
+        default_value = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"
+    )]
+    pub font: PathBuf,
+}
+
+const METHODS: [Method; 5] = [
+    Method::Discrete,
+    Method::Substep(4),
+    Method::Swept,
+    Method::Event,
+    Method::Auto,
+];
+
+/// Runs the command.
+pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
+    let points = chart_points(&METHODS)?;
+    writeln!(
+        out,
+        "method      dt          cost (s per sim s per critter)  error (radii)"
+    )?;
+    for p in &points {
+        writeln!(
+            out,
+            "{:<11} {:<11.3e} {:<31.3e} {:.3e}",
+            p.method.to_string(),
+            p.dt,
+            p.cost,
+            p.error
+        )?;
+    }
+    let svg = args.out.with_extension("svg");
+    let png = args.out.with_extension("png");
+    let font = std::fs::read(&args.font).with_context(|| {
+        format!(
+            "{}: the PNG needs a TrueType font (--font)",
+            args.font.display()
+        )
+    })?;
+    let font: &'static [u8] = Box::leak(font.into_boxed_slice());
+    plotters::style::register_font("sans-serif", FontStyle::Normal, font)
+        .map_err(|_| anyhow::anyhow!("{}: not a usable TrueType font", args.font.display()))?;
+    draw(
+        SVGBackend::new(&svg, (900, 600)).into_drawing_area(),
+        &points,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
+    draw(
+        BitMapBackend::new(&png, (900, 600)).into_drawing_area(),
+        &points,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", png.display()))?;
+    writeln!(out, "wrote {} and {}", svg.display(), png.display())?;
+    Ok(())
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    points: &[ChartPoint],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    const FLOOR: f64 = 1e-16; // errors below this are drawn at it (exact to round-off)
+    root.fill(&WHITE)?;
+    let err = |p: &ChartPoint| p.error.max(FLOOR);
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in points {
+        x0 = x0.min(err(p));
+        x1 = x1.max(err(p));
+        y0 = y0.min(p.cost);
+        y1 = y1.max(p.cost);
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "critterbox: cost against error (100-disk gas, 1 s, dt 1/15 to 1/960)",
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            (x0 / 3.0..x1 * 3.0).log_scale(),
+            (y0 / 2.0..y1 * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("RMS position error against the exact event-driven run (radii)")
+        .y_desc("wall s per simulated s per critter")
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .draw()?;
+    for (i, m) in METHODS.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.method == *m)
+            .map(|p| (err(p), p.cost))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
+            .label(m.to_string())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}

@@ -1,0 +1,224 @@
+//! What `critterbox run` adds for recording: the `--record` flags, the run's metadata, the
+//! recorder's start and end, and Ctrl-C, which ends the run early with the file finished.
+
+use super::run::RunArgs;
+use crate::recording::keyframes::default_record_every;
+use crate::recording::meta::utc_now;
+use crate::recording::{path, EndMeta, Recorder, RunMeta, SceneSource, Written};
+use crate::scenes::{AnyWorld, Scene, SourceFile};
+use crate::script::Limits;
+use clap::Args;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Recording options of `critterbox run`.
+#[derive(Args, Debug, Default, Clone)]
+pub struct RecordArgs {
+    /// Write the recording to PATH (default: recordings/<scene>-<YYYYMMDD-HHMMSS>.mcap, or under
+    /// $CRITTERBOX_RECORDINGS).
+    #[arg(long, value_name = "PATH", help_heading = "Recording")]
+    pub record: Option<PathBuf>,
+    /// Do not record this run.
+    #[arg(long, conflicts_with = "record", help_heading = "Recording")]
+    pub no_record: bool,
+    /// Record the full state every K steps (1 = every step). Hash, totals and events are recorded
+    /// every step anyway. Default: every step for scenes of up to 100 critters, else a K chosen to
+    /// keep recording under 10% of the step time (see docs/recording-format.md).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..), help_heading = "Recording")]
+    pub record_every: Option<u64>,
+}
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// From now on, Ctrl-C asks the run to stop after the current step (and a second Ctrl-C quits at
+/// once).
+pub fn watch_ctrl_c() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = ctrlc::set_handler(|| {
+            if INTERRUPTED.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    });
+}
+
+/// True once Ctrl-C was pressed.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
+
+fn world_seed(world: &AnyWorld) -> u64 {
+    match world {
+        AnyWorld::D2(w) => w.seed(),
+        AnyWorld::D3(w) => w.seed(),
+    }
+}
+
+/// The run's metadata.
+pub fn run_meta(args: &RunArgs, scene: &Scene, steps: u64) -> RunMeta {
+    let world = &scene.world;
+    let source = match scene.sources.first() {
+        Some(file) => SceneSource::Script {
+            file: file.path.clone(),
+        },
+        None => SceneSource::Builtin,
+    };
+    RunMeta {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: scene.name.clone(),
+        source,
+        seed: world_seed(world),
+        seed_override: args.seed,
+        dt: world.dt(),
+        dt_override: args.dt,
+        steps,
+        method: world.method().to_string(),
+        dim: world.dim(),
+        border: format!("{:?}", world.border()).to_lowercase(),
+        n: args.n,
+        sets: args.sets.clone(),
+        limits: Limits {
+            max_operations: args.max_ops,
+            max_spawns_per_step: args.max_spawns,
+            max_call_levels: args.max_call_depth,
+            max_string_size: args.max_string,
+            max_array_size: args.max_array,
+            max_map_size: args.max_map,
+        },
+        command_line: std::env::args().collect(),
+        record_every: args
+            .recording
+            .record_every
+            .unwrap_or_else(|| default_record_every(world.len())),
+        critters: world.len(),
+        created: utc_now().1,
+    }
+}
+
+/// Starts recording, unless `--no-record`.
+pub fn start(args: &RunArgs, scene: &Scene, steps: u64) -> anyhow::Result<Option<Recorder>> {
+    if args.recording.no_record {
+        return Ok(None);
+    }
+    let file = match &args.recording.record {
+        Some(p) => p.clone(),
+        None => path::new_path(&path::default_dir(), &scene.name),
+    };
+    let meta = run_meta(args, scene, steps);
+    Ok(Some(Recorder::create(
+        &file,
+        &meta,
+        &scene.sources,
+        &scene.world,
+    )?))
+}
+
+/// Kinds the scene loaded after it was set up (from `on_step`), which its `sources` do not
+/// list: found where the scene's kind search finds them.
+fn late_kinds(scene: &Scene) -> Vec<SourceFile> {
+    let Some(scene_file) = scene.sources.first() else {
+        return Vec::new();
+    };
+    let stem = |p: &str| {
+        Path::new(p)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+    };
+    let known: Vec<String> = scene.sources.iter().filter_map(|s| stem(&s.path)).collect();
+    let names: Vec<String> = match &scene.world {
+        AnyWorld::D2(w) => w.kinds().iter().map(|(_, k)| k.name.clone()).collect(),
+        AnyWorld::D3(w) => w.kinds().iter().map(|(_, k)| k.name.clone()).collect(),
+    };
+    let dir = Path::new(&scene_file.path)
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let search = [
+        dir.join("../kinds"),
+        dir.join("kinds"),
+        dir.clone(),
+        PathBuf::from("scripts/kinds"),
+    ];
+    let mut found = Vec::new();
+    for name in names {
+        if name == "ball" || name == "wall" || known.contains(&name) {
+            continue;
+        }
+        if let Some(p) = search
+            .iter()
+            .map(|d| d.join(format!("{name}.rhai")))
+            .find(|p| p.is_file())
+        {
+            if let Ok(text) = std::fs::read_to_string(&p) {
+                found.push(SourceFile {
+                    path: p.display().to_string(),
+                    text,
+                });
+            }
+        }
+    }
+    found
+}
+
+/// Closes the recording after the run and says where it is.
+pub fn finish(
+    recorder: Option<Recorder>,
+    scene: &Scene,
+    outcome: &str,
+    reason: &str,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let Some(mut rec) = recorder else {
+        return Ok(());
+    };
+    rec.attach(late_kinds(scene))?;
+    let end = EndMeta {
+        steps: scene.world.step_count(),
+        outcome: outcome.into(),
+        reason: reason.into(),
+        hash: scene.world.state_hash(),
+    };
+    let w = rec.finish(&scene.world, end)?;
+    print_written(out, &w, outcome)
+}
+
+/// Records the error that stopped the run and closes the file, before the error is reported.
+pub fn fail(
+    recorder: Option<Recorder>,
+    scene: &Scene,
+    error: &anyhow::Error,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let Some(mut rec) = recorder else {
+        return Ok(());
+    };
+    let message = format!("{error:#}");
+    rec.record_error(&scene.world, &message)?;
+    rec.attach(late_kinds(scene))?;
+    let end = EndMeta {
+        steps: scene.world.step_count(),
+        outcome: "error".into(),
+        reason: message,
+        hash: scene.world.state_hash(),
+    };
+    let w = rec.finish(&scene.world, end)?;
+    print_written(out, &w, "error")
+}
+
+fn print_written(out: &mut dyn Write, w: &Written, outcome: &str) -> anyhow::Result<()> {
+    let note = match outcome {
+        "completed" | "stopped" => String::new(),
+        other => format!(", ended by {other}"),
+    };
+    writeln!(
+        out,
+        "recording    {} ({} steps, {} full states, {:.1} KiB{note})",
+        w.path.display(),
+        w.steps,
+        w.states,
+        w.bytes as f64 / 1024.0
+    )?;
+    Ok(())
+}

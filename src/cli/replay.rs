@@ -1,0 +1,227 @@
+//! `critterbox replay FILE`: a recording played back headless: a summary and per-step totals,
+//! the exact state of any step (`--step N`), or a check that re-simulating from the file alone
+//! gives every recorded step bit for bit (`--verify`).
+
+use crate::recording::replay::{state_at_step, StateSource};
+use crate::recording::schema::{id_of, StateMsg};
+use crate::recording::verify::verify;
+use crate::recording::{Recording, SceneSource};
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `critterbox replay`.
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// The recording (.mcap).
+    pub file: PathBuf,
+    /// Re-simulate from the recording alone and check every step's hash, totals and events and
+    /// every full state; exit non-zero at the first difference.
+    #[arg(long)]
+    pub verify: bool,
+    /// Print the exact state after step N (re-simulated when it was not recorded).
+    #[arg(long, value_name = "N")]
+    pub step: Option<u64>,
+    /// With --step: print the state as the recording's JSON state message.
+    #[arg(long, requires = "step")]
+    pub json: bool,
+    /// Rows of the per-step totals table.
+    #[arg(long, default_value_t = 12)]
+    pub rows: usize,
+}
+
+/// Runs the command.
+pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
+    let rec = Recording::open(&args.file)?;
+    if let Some(step) = args.step {
+        let (state, source) = state_at_step(&rec, step)?;
+        if args.json {
+            writeln!(out, "{}", serde_json::to_string(&state)?)?;
+        } else {
+            let how = match source {
+                StateSource::Recorded => "recorded".to_string(),
+                StateSource::Resimulated { keyframe } => format!(
+                    "re-simulated from step 0; every hash matched{}",
+                    keyframe.map_or(String::new(), |k| format!(
+                        ", and the full state at step {k}"
+                    ))
+                ),
+            };
+            writeln!(out, "step {step} (t = {}): {how}", state.time.0)?;
+            print_state(out, &state)?;
+        }
+        return warn_truncated(&rec, out);
+    }
+    summary(&rec, out, args.rows)?;
+    if args.verify {
+        let report = verify(&rec, |_| {})?;
+        match &report.mismatch {
+            None => {
+                writeln!(
+                    out,
+                    "verify       ok: {} steps re-simulated from the recording alone; {} hashes, {} full states and {} event messages identical{}",
+                    report.steps,
+                    report.hashes,
+                    report.states,
+                    report.events,
+                    report
+                        .error_reproduced
+                        .map_or(String::new(), |s| format!("; the error in step {s} reproduced"))
+                )?;
+            }
+            Some(m) => {
+                writeln!(out, "verify       MISMATCH at step {}: {}", m.step, m.what)?;
+                match &m.critter {
+                    Some((at, c)) => writeln!(out, "first critter that differs (step {at}): {c}")?,
+                    None => writeln!(out, "no recorded full state after it to name a critter")?,
+                }
+                warn_truncated(&rec, out)?;
+                anyhow::bail!(
+                    "{}: the replay differs from the recording at step {}",
+                    args.file.display(),
+                    m.step
+                );
+            }
+        }
+    }
+    warn_truncated(&rec, out)
+}
+
+fn warn_truncated(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> {
+    if let Some(t) = &rec.truncated {
+        writeln!(
+            out,
+            "warning      the file is cut off after step {}: {t} (`critterbox recover` writes a complete copy)",
+            rec.last_step()
+        )?;
+    }
+    Ok(())
+}
+
+fn fnum(x: f64) -> String {
+    ryu::Buffer::new().format(x).to_string()
+}
+
+/// The header lines every recording command prints.
+pub fn summary_head(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> {
+    let m = rec.meta();
+    let bytes = std::fs::metadata(&rec.path).map_or(0, |x| x.len());
+    writeln!(
+        out,
+        "recording    {} ({:.1} KiB)",
+        rec.path.display(),
+        bytes as f64 / 1024.0
+    )?;
+    let source = match &m.source {
+        SceneSource::Builtin => format!(
+            "built-in{}",
+            m.n.map_or(String::new(), |n| format!(", n = {n}"))
+        ),
+        SceneSource::Script { file } => format!("script {file}"),
+    };
+    writeln!(
+        out,
+        "scene        {} ({source}; {}D, {} border)",
+        m.scene, m.dim, m.border
+    )?;
+    writeln!(
+        out,
+        "recorded     by critterbox {} at {}: seed {}, dt {}, method {}",
+        m.version,
+        m.created,
+        m.seed,
+        fnum(m.dt),
+        m.method
+    )?;
+    if !m.command_line.is_empty() {
+        writeln!(out, "command      {}", m.command_line.join(" "))?;
+    }
+    let ended = match (&rec.end, &rec.error) {
+        (_, Some(e)) => format!("ended by an error in step {}: {}", e.step, e.message),
+        (Some(e), _) if e.outcome == "stopped" => format!("stopped by the scene: {}", e.reason),
+        (Some(e), _) => e.outcome.clone(),
+        (None, _) => "no end record (the run did not finish writing)".into(),
+    };
+    writeln!(
+        out,
+        "steps        {} of {} asked ({ended})",
+        rec.last_step(),
+        m.steps
+    )?;
+    writeln!(
+        out,
+        "full states  every {} step{} ({} in the file); hash, totals and events every step",
+        m.record_every,
+        if m.record_every == 1 { "" } else { "s" },
+        rec.keyframes.len()
+    )?;
+    Ok(())
+}
+
+fn summary(rec: &Recording, out: &mut dyn Write, rows: usize) -> anyhow::Result<()> {
+    summary_head(rec, out)?;
+    let dim = rec.meta().dim;
+    writeln!(out, "per-step totals")?;
+    let mut head = format!(
+        "  {:>8} {:>10} {:>8} {:>10} {:>22}",
+        "step", "time", "critters", "collisions", "kinetic energy"
+    );
+    for axis in ["px", "py", "pz"].iter().take(dim) {
+        head.push_str(&format!(" {axis:>14}"));
+    }
+    writeln!(out, "{head}")?;
+    for t in sample(&rec.totals, rows) {
+        let mut line = format!(
+            "  {:>8} {:>10.4} {:>8} {:>10} {:>22}",
+            t.step,
+            t.time.0,
+            t.critters,
+            t.collisions,
+            fnum(t.kinetic_energy.0)
+        );
+        for p in &t.momentum.0 {
+            line.push_str(&format!(" {p:>14.6e}"));
+        }
+        writeln!(out, "{line}")?;
+    }
+    Ok(())
+}
+
+/// At most `rows` items, evenly spread, always with the first and the last.
+pub fn sample<T>(items: &[T], rows: usize) -> Vec<&T> {
+    let n = items.len();
+    if n <= rows.max(2) {
+        return items.iter().collect();
+    }
+    let rows = rows.max(2);
+    (0..rows)
+        .map(|i| &items[i * (n - 1) / (rows - 1)])
+        .collect()
+}
+
+/// A full state as a table, floats in shortest round-trip form (exact).
+pub fn print_state(out: &mut dyn Write, s: &StateMsg) -> anyhow::Result<()> {
+    let dim = s.dim();
+    let mut head = vec!["id", "kind", "x", "y"];
+    if dim == 3 {
+        head.push("z");
+    }
+    head.extend(["vx", "vy"]);
+    if dim == 3 {
+        head.push("vz");
+    }
+    head.extend(["radius", "mass", "health"]);
+    writeln!(out, "{}", head.join("\t"))?;
+    for i in 0..s.len() {
+        let mut row = vec![id_of(s.id[i]).to_string(), s.kind_name(i).to_string()];
+        let fields = s.fields(i);
+        for (name, x) in &fields {
+            if matches!(*name, "restitution" | "priority") {
+                continue;
+            }
+            row.push(fnum(*x));
+        }
+        writeln!(out, "{}", row.join("\t"))?;
+    }
+    Ok(())
+}

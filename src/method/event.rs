@@ -1,0 +1,27 @@
+//! `event`: exact event-driven dynamics.
+//!
+//! Between events critters fly exactly: straight lines, or parabolas under the world's uniform
+//! gravity (fixed critters do not fall). Pair collisions (equal accelerations cancel, so a pair
+//! of free disks is a quadratic in time), wall hits (quadratic against a face when no gravity,
+//! conservative advancement on the exact box distance along a parabola), border hits, and cell
+//! crossings (so each critter only looks at its neighbours) are predicted and processed in time
+//! order by [`crate::method::flight`]; each collision is handed to the caller's `collide` hook.
+//! A step advances exactly dt of event time. See `flight` for the treatment of round-off,
+//! inelastic collapse and resting contacts.
+
+use crate::error::Error;
+use crate::vector::Vector;
+use crate::world::{StepStats, World};
+
+/// One event-driven step of exactly dt (after the update hooks, before the lifecycle).
+pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
+    let clock = std::time::Instant::now();
+    let g = world.gravity;
+    let complete = crate::method::flight::run(world, g, world.dt, stats)?;
+    stats.response += clock.elapsed();
+    if !complete {
+        stats.budget_exceeded += 1;
+        world.discrete_collide(stats)?;
+    }
+    Ok(())
+}

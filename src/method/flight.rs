@@ -1,0 +1,921 @@
+//! The event engine shared by `swept` and `event`: critters fly (straight, or on parabolas under
+//! uniform acceleration) between events, and events are processed in time order.
+//!
+//! Events: pair collisions, wall hits, border hits (bounce and clamp borders) and cell crossings
+//! (Rapaport, J. Comput. Phys. 34, 1980): the world box is cut into cells at least one diameter
+//! wide, a critter predicts collisions only with critters in its own and the neighbouring cells,
+//! and crossing into a new cell is an event that predicts against the new neighbours. Each
+//! critter keeps its own clock (it is advanced only when it takes part in an event) and an event
+//! counter; an event stores its critters' counters when predicted and is stale once either has
+//! changed (lazy invalidation in one binary heap). Ties are broken by time, then ids, then kind.
+//!
+//! Finite precision (Bannerman et al., arXiv:1211.6718): collisions are predicted for a contact
+//! distance a hair (`SKIN`, relative) inside the true one, so at the predicted time the pair
+//! really touches and the response sees it; a pair found overlapping is collided at once (when
+//! it approaches, that is the Bannerman rule; when it separates, the response only separates).
+//!
+//! Inelastic collapse: a collision within `TC_FRACTION x dt` of either critter's previous one is
+//! elastic (the TC model of Luding and McNamara), which stops the infinite sequence of ever
+//! shorter intervals. An event budget per step bounds the cost of what remains (resting
+//! contacts under gravity); when it runs out the step is finished by the discrete pass and
+//! counted in `StepStats::budget_exceeded`.
+
+use crate::border::Border;
+use crate::contact::contact_wall_ball;
+use crate::critter::{Shape, CLASS_UNSET};
+use crate::error::Error;
+use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_wall_ball};
+use crate::rules::PairRule;
+use crate::vector::Vector;
+use crate::world::{at_step, roles_order, StepStats, World};
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+/// Relative shrink of contact distances used for prediction.
+pub const SKIN: f64 = 1e-10;
+/// Collisions closer than this fraction of dt to the critter's previous one are elastic.
+pub const TC_FRACTION: f64 = 1e-9;
+/// Events per critter per step before the step falls back to the discrete pass.
+pub const BUDGET_PER_CRITTER: u64 = 64;
+/// Conservative-advancement iterations before a curved prediction is continued by a recheck.
+const CA_ITERATIONS: usize = 64;
+
+const NONE: u32 = u32::MAX;
+const PAIR: u8 = 0;
+const WALL: u8 = 1;
+const BORDER: u8 = 2;
+const CELL: u8 = 3;
+const RECHECK: u8 = 4;
+const BORDER_TAG: u32 = u32::MAX - 16;
+
+#[derive(Clone, Copy, Debug)]
+struct Ev {
+    time: f64,
+    a: u32,
+    b: u32,
+    kind: u8,
+    ca: u32,
+    cb: u32,
+}
+
+impl PartialEq for Ev {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Ev {}
+impl PartialOrd for Ev {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Ev {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.time
+            .total_cmp(&o.time)
+            .then(self.a.cmp(&o.a))
+            .then(self.b.cmp(&o.b))
+            .then(self.kind.cmp(&o.kind))
+            .then(self.ca.cmp(&o.ca))
+            .then(self.cb.cmp(&o.cb))
+    }
+}
+
+/// What predictions read about a critter, kept compact and contiguous (the critters themselves
+/// are large and scattered); refreshed whenever the flight or a hook changes the critter.
+#[derive(Clone, Copy, Debug, Default)]
+struct Body<V> {
+    pos: V,
+    vel: V,
+    /// The body's own clock: `pos` and `vel` hold at this time.
+    t: f64,
+    radius: f64,
+    /// Accelerates with the flight's gravity (free disks).
+    free: bool,
+    alive: bool,
+    wall: bool,
+}
+
+/// Per-world scratch kept between steps so a step allocates nothing once warmed up.
+#[derive(Default)]
+pub(crate) struct Scratch<V> {
+    body: Vec<Body<V>>,
+    count: Vec<u32>,
+    cell: Vec<u32>,
+    last: Vec<u32>,
+    last_t: Vec<f64>,
+    cells: Vec<Vec<u32>>,
+    cell_walls: Vec<Vec<u32>>,
+    heap: BinaryHeap<Reverse<Ev>>,
+    /// The earliest event found so far by the running `predict_all`.
+    cand: Option<Ev>,
+    /// Pairs whose hook left them overlapping this step: not handed back at once again.
+    stuck: std::collections::HashSet<u64>,
+    dims: [usize; 3],
+    side: [f64; 3],
+    acc: V,
+    t_end: f64,
+    tc: f64,
+    budget: u64,
+    predictions: u64,
+    pair_tests: u64,
+    /// Sum over default collisions of contact distance x impulse (the collision virial).
+    pub virial: f64,
+}
+
+/// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
+/// processing every event in order. Returns false when the event budget ran out (the critters
+/// are then all at `t_end`, with the remaining events skipped).
+pub(crate) fn run<V: Vector>(
+    world: &mut World<V>,
+    acc: V,
+    t_end: f64,
+    stats: &mut StepStats,
+) -> Result<bool, Error> {
+    let mut sc = std::mem::take(&mut world.flight);
+    let out = run_with(world, &mut sc, acc, t_end, stats);
+    sc.heap.clear();
+    world.flight = sc;
+    out
+}
+
+fn run_with<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    t_end: f64,
+    stats: &mut StepStats,
+) -> Result<bool, Error> {
+    setup(w, sc, acc, t_end);
+    let n = w.critters.slot_count() as u32;
+    for a in 0..n {
+        predict_all(w, sc, a, 0.0)?;
+    }
+    let mut processed = 0u64;
+    let mut complete = true;
+    while let Some(Reverse(ev)) = sc.heap.pop() {
+        if ev.time > t_end {
+            break;
+        }
+        match validity(sc, &ev) {
+            Validity::Stale => continue,
+            Validity::PartnerChanged => {
+                predict_all(w, sc, ev.a, ev.time)?;
+                continue;
+            }
+            Validity::Valid => {}
+        }
+        processed += 1;
+        if processed > sc.budget {
+            complete = false;
+            break;
+        }
+        let t = ev.time;
+        match ev.kind {
+            PAIR | WALL => {
+                advance(w, sc, ev.a, t);
+                advance(w, sc, ev.b, t);
+                stats.contacts += 1;
+                let deaths = w.pending.deaths.len();
+                if collide(w, sc, ev.a, ev.b, t)? {
+                    stats.collisions += 1;
+                }
+                // A hook may kill third critters: their bodies must know.
+                for i in deaths..w.pending.deaths.len() {
+                    let x = w.pending.deaths[i].index;
+                    refresh(w, sc, x);
+                }
+                if let (Some(x), Some(y)) = (w.critters.slot(ev.a), w.critters.slot(ev.b)) {
+                    if x.alive && y.alive {
+                        if let Some(c) = crate::response::contact_between(&w.topo, x, y) {
+                            if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {
+                                sc.stuck.insert(pair_key(ev.a, ev.b));
+                            }
+                        }
+                    }
+                }
+                sc.last[ev.a as usize] = ev.b;
+                sc.last_t[ev.a as usize] = t;
+                if ev.kind == PAIR {
+                    sc.last[ev.b as usize] = ev.a;
+                    sc.last_t[ev.b as usize] = t;
+                }
+                for x in [ev.a, ev.b] {
+                    if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
+                        sc.count[x as usize] = sc.count[x as usize].wrapping_add(1);
+                        relocate(w, sc, x);
+                        refresh(w, sc, x);
+                    }
+                }
+                for x in [ev.a, ev.b] {
+                    predict_all(w, sc, x, t)?;
+                }
+            }
+            BORDER => {
+                advance(w, sc, ev.a, t);
+                bounce_border(w, ev.a, ev.b);
+                refresh(w, sc, ev.a);
+                sc.last[ev.a as usize] = BORDER_TAG + ev.b;
+                sc.count[ev.a as usize] = sc.count[ev.a as usize].wrapping_add(1);
+                predict_all(w, sc, ev.a, t)?;
+            }
+            CELL => {
+                cross_cell(w, sc, ev.a, ev.b, t);
+                refresh(w, sc, ev.a);
+                predict_all(w, sc, ev.a, t)?;
+            }
+            _ => {
+                // RECHECK: continue a curved prediction that did not settle.
+                predict_all(w, sc, ev.a, t)?;
+            }
+        }
+    }
+    stats.events += processed.min(sc.budget);
+    stats.pair_tests += sc.pair_tests;
+    stats.candidates += sc.predictions as usize;
+    // Everyone to the end of the flight.
+    let topo = w.topo;
+    for a in 0..n {
+        advance(w, sc, a, t_end);
+        if let Some(c) = w.critters.slot_mut(a) {
+            if c.alive && !c.is_wall() {
+                c.pos = if topo.wraps() {
+                    topo.wrap_position(c.pos)
+                } else {
+                    topo.apply(c.pos, c.vel, c.radius, c.restitution).0
+                };
+            }
+        }
+    }
+    Ok(complete)
+}
+
+#[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
+fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
+    let n = w.critters.slot_count();
+    sc.heap.clear();
+    sc.stuck.clear();
+    for v in [&mut sc.count, &mut sc.cell, &mut sc.last] {
+        v.clear();
+        v.resize(n, NONE);
+    }
+    sc.count.iter_mut().for_each(|c| *c = 0);
+    sc.body.clear();
+    sc.body.resize(n, Body::default());
+    for a in 0..n as u32 {
+        refresh(w, sc, a);
+    }
+    sc.last_t.clear();
+    sc.last_t.resize(n, f64::NEG_INFINITY);
+    sc.acc = acc;
+    sc.t_end = t_end;
+    sc.tc = TC_FRACTION * w.dt;
+    sc.virial = 0.0;
+    sc.predictions = 0;
+    sc.pair_tests = 0;
+    let mut rmax: f64 = 0.0;
+    let mut disks = 0usize;
+    for c in w.critters.iter_mut() {
+        if c.class == CLASS_UNSET {
+            c.class = w.rules.class_of(&w.kinds, c);
+        }
+        if c.alive && !c.is_wall() {
+            rmax = rmax.max(c.radius);
+            disks += 1;
+        }
+    }
+    sc.budget = BUDGET_PER_CRITTER * disks as u64 + 10_000;
+    // Cells at least one diameter wide, at most about 2 per disk.
+    let size = w.topo.size();
+    let dim = V::DIM;
+    let want = (2.0 * rmax * (1.0 + 1e-9)).max(f64::MIN_POSITIVE);
+    let mut dims = [1usize; 3];
+    for axis in 0..dim {
+        dims[axis] = ((size.get(axis) / want).floor() as usize).clamp(1, 1 << 20);
+    }
+    let cap = (2 * disks).max(27);
+    while dims[..dim].iter().product::<usize>() > cap {
+        for d in dims[..dim].iter_mut() {
+            *d = (*d).div_ceil(2).max(1);
+        }
+    }
+    for axis in 0..3 {
+        sc.side[axis] = if axis < dim {
+            size.get(axis) / dims[axis] as f64
+        } else {
+            1.0
+        };
+    }
+    sc.dims = dims;
+    let total: usize = dims[..dim].iter().product();
+    sc.cells.iter_mut().for_each(Vec::clear);
+    sc.cells.resize_with(total, Vec::new);
+    sc.cell_walls.iter_mut().for_each(Vec::clear);
+    sc.cell_walls.resize_with(total, Vec::new);
+    for c in w.critters.iter() {
+        if !c.alive {
+            continue;
+        }
+        match &c.shape {
+            Shape::Disk => {
+                let k = cell_of(w, sc, c.pos);
+                sc.cell[c.id.index as usize] = k as u32;
+                sc.cells[k].push(c.id.index);
+            }
+            Shape::Wall(wall) => {
+                // Every cell a disk centre could be in while touching the wall.
+                let half = wall.aabb_half() + V::splat(rmax + 1e-9 * rmax);
+                let mut lo = [0i64; 3];
+                let mut hi = [0i64; 3];
+                for axis in 0..dim {
+                    let m = w.topo.min.get(axis);
+                    let s = sc.side[axis];
+                    lo[axis] = ((c.pos.get(axis) - half.get(axis) - m) / s).floor() as i64;
+                    hi[axis] = ((c.pos.get(axis) + half.get(axis) - m) / s).floor() as i64;
+                    let n = dims[axis] as i64;
+                    if w.topo.wraps() {
+                        if hi[axis] - lo[axis] + 1 >= n {
+                            lo[axis] = 0;
+                            hi[axis] = n - 1;
+                        }
+                    } else {
+                        lo[axis] = lo[axis].clamp(0, n - 1);
+                        hi[axis] = hi[axis].clamp(0, n - 1);
+                    }
+                }
+                for z in lo[2]..=hi[2] {
+                    for y in lo[1]..=hi[1] {
+                        for x in lo[0]..=hi[0] {
+                            let k = key(&dims, [x, y, z]);
+                            sc.cell_walls[k].push(c.id.index);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn pair_key(a: u32, b: u32) -> u64 {
+    ((a.min(b) as u64) << 32) | a.max(b) as u64
+}
+
+#[inline]
+fn key(dims: &[usize; 3], c: [i64; 3]) -> usize {
+    let m = |i: i64, n: usize| {
+        let n = n as i64;
+        (if i < 0 {
+            i + n
+        } else if i >= n {
+            i - n
+        } else {
+            i
+        }) as usize
+    };
+    m(c[0], dims[0]) + dims[0] * (m(c[1], dims[1]) + dims[1] * m(c[2], dims[2]))
+}
+
+fn coords(dims: &[usize; 3], k: usize) -> [i64; 3] {
+    [
+        (k % dims[0]) as i64,
+        ((k / dims[0]) % dims[1]) as i64,
+        (k / (dims[0] * dims[1])) as i64,
+    ]
+}
+
+fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> usize {
+    let mut c = [0i64; 3];
+    for (axis, ca) in c.iter_mut().enumerate().take(V::DIM) {
+        let x = ((p.get(axis) - w.topo.min.get(axis)) / sc.side[axis]).floor() as i64;
+        *ca = x.clamp(0, sc.dims[axis] as i64 - 1);
+    }
+    key(&sc.dims, c)
+}
+
+/// Copies critter `a` into its body (after the flight or a hook changed it).
+#[inline]
+fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
+    let t = sc.body[a as usize].t;
+    sc.body[a as usize] = match w.critters.slot(a) {
+        Some(c) => Body {
+            pos: c.pos,
+            vel: c.vel,
+            t,
+            radius: c.radius,
+            free: !c.fixed && !c.is_wall(),
+            alive: c.alive,
+            wall: c.is_wall(),
+        },
+        None => Body::default(),
+    };
+}
+
+/// Position, velocity and acceleration of body `a` at time `t` (its own clock is `body.t`).
+#[inline]
+fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
+    let b = &sc.body[a as usize];
+    let acc = if b.free { sc.acc } else { V::zero() };
+    let h = t - b.t;
+    if h == 0.0 {
+        return (b.pos, b.vel, acc);
+    }
+    (
+        b.pos + b.vel * h + acc * (0.5 * h * h),
+        b.vel + acc * h,
+        acc,
+    )
+}
+
+fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+    let b = sc.body[a as usize];
+    if !b.alive || b.wall {
+        return;
+    }
+    let (p, v, _) = state_at(sc, a, t);
+    let body = &mut sc.body[a as usize];
+    body.pos = p;
+    body.vel = v;
+    body.t = t;
+    if let Some(c) = w.critters.slot_mut(a) {
+        c.pos = p;
+        c.vel = v;
+    }
+}
+
+enum Validity {
+    Valid,
+    /// The owner has changed since: it has a newer event already.
+    Stale,
+    /// The partner has changed: the owner must predict again.
+    PartnerChanged,
+}
+
+fn validity<V: Vector>(sc: &Scratch<V>, ev: &Ev) -> Validity {
+    let alive = |x: u32| sc.body[x as usize].alive;
+    if !alive(ev.a) || sc.count[ev.a as usize] != ev.ca {
+        return Validity::Stale;
+    }
+    let ok = match ev.kind {
+        PAIR => alive(ev.b) && sc.count[ev.b as usize] == ev.cb,
+        WALL => alive(ev.b),
+        _ => true,
+    };
+    if ok {
+        Validity::Valid
+    } else {
+        Validity::PartnerChanged
+    }
+}
+
+/// Offers an event to the running prediction: each critter keeps only its earliest event in
+/// the heap (a stale partner makes it predict again when that event comes up).
+#[inline]
+fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: u8) {
+    if sc.cand.is_some_and(|c| time > c.time) {
+        return;
+    }
+    let cb = if kind == PAIR {
+        sc.count.get(b as usize).copied().unwrap_or(0)
+    } else {
+        0
+    };
+    let ev = Ev {
+        time,
+        a,
+        b,
+        kind,
+        ca: sc.count[a as usize],
+        cb,
+    };
+    if sc.cand.is_none_or(|c| ev < c) {
+        sc.cand = Some(ev);
+    }
+}
+
+/// Predicts every next event of disk `a` from time `t`. `initial`: pairs only with higher slots.
+fn predict_all<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    t: f64,
+) -> Result<(), Error> {
+    let me = sc.body[a as usize];
+    if !me.alive || me.wall {
+        return Ok(());
+    }
+    sc.cand = None;
+    sc.predictions += 1;
+    let mine = state_at(sc, a, t);
+    let home = sc.cell[a as usize] as usize;
+    let dims = sc.dims;
+    let hc = coords(&dims, home);
+    let small = dims[..V::DIM].iter().any(|&n| n < 3);
+    let mut seen = [usize::MAX; 27];
+    let mut nseen = 0;
+    let reach = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
+    for dz in reach(2) {
+        for dy in reach(1) {
+            for dx in reach(0) {
+                let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
+                if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
+                {
+                    continue;
+                }
+                let k = key(&dims, cc);
+                if small {
+                    // Fewer than three cells along an axis: neighbours repeat.
+                    if seen[..nseen].contains(&k) {
+                        continue;
+                    }
+                    seen[nseen] = k;
+                    nseen += 1;
+                }
+                for i in 0..sc.cells[k].len() {
+                    let b = sc.cells[k][i];
+                    if b == a {
+                        continue;
+                    }
+                    predict_pair_or_wall(w, sc, a, b, t, mine)?;
+                }
+            }
+        }
+    }
+    for i in 0..sc.cell_walls[home].len() {
+        let b = sc.cell_walls[home][i];
+        predict_pair_or_wall(w, sc, a, b, t, mine)?;
+    }
+    predict_border(w, sc, a, t);
+    predict_cell(w, sc, a, t);
+    if let Some(ev) = sc.cand.take() {
+        sc.heap.push(Reverse(ev));
+        if sc.heap.len() > 3 * sc.count.len() + 1024 {
+            // Lazy invalidation leaves stale events behind; drop those whose owner has
+            // predicted again since, so the heap stays about one event per critter.
+            let count = &sc.count;
+            sc.heap.retain(|Reverse(e)| count[e.a as usize] == e.ca);
+        }
+    }
+    Ok(())
+}
+
+#[inline]
+fn predict_pair_or_wall<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    b: u32,
+    t: f64,
+    mine: (V, V, V),
+) -> Result<(), Error> {
+    sc.pair_tests += 1;
+    let (body_a, body_b) = (sc.body[a as usize], sc.body[b as usize]);
+    if !body_b.alive {
+        return Ok(());
+    }
+    let horizon = sc.t_end - t;
+    if horizon < 0.0 {
+        return Ok(());
+    }
+    let (pa, va, aa) = mine;
+    let is_wall = body_b.wall;
+    let just_met = sc.last[a as usize] == b && (is_wall || sc.last[b as usize] == a);
+    let (kind, s) = if is_wall {
+        let Some(cb) = w.critters.slot(b) else {
+            return Ok(());
+        };
+        let Shape::Wall(wall) = &cb.shape else {
+            return Ok(());
+        };
+        let d = w.topo.delta(cb.pos, pa);
+        let r = body_a.radius * (1.0 - SKIN);
+        let s = if aa.length_squared() == 0.0 {
+            toi_wall_ball(wall, d, va, r)
+        } else if contact_wall_ball(wall, d, r).is_some() {
+            Some(0.0)
+        } else {
+            let vb = va.length() + aa.length() * horizon;
+            let gap = |s: f64| {
+                let p = d + va * s + aa * (0.5 * s * s);
+                let f = wall.closest_feature(p);
+                let dist = (p - f.offset).length();
+                if f.inside {
+                    -dist - r
+                } else {
+                    dist - r
+                }
+            };
+            match advance_to_contact(gap, vb, horizon, body_a.radius) {
+                Advance::Hit(s) => Some(s),
+                Advance::Miss => None,
+                Advance::Continue(s) => {
+                    push(sc, t + s, a, b, RECHECK);
+                    None
+                }
+            }
+        };
+        (WALL, s)
+    } else {
+        let (pb, vb, ab) = state_at(sc, b, t);
+        let d = w.topo.delta(pa, pb);
+        let wv = vb - va;
+        let ar = ab - aa;
+        let r = (body_a.radius + body_b.radius) * (1.0 - SKIN);
+        let s = if d.length_squared() < r * r {
+            Some(0.0) // overlapping: collide now (approaching or not)
+        } else if ar.length_squared() == 0.0 {
+            toi_ball_ball(d, wv, r)
+        } else {
+            let speed = wv.length() + ar.length() * horizon;
+            let gap = |s: f64| (d + wv * s + ar * (0.5 * s * s)).length() - r;
+            match advance_to_contact(gap, speed, horizon, r) {
+                Advance::Hit(s) => Some(s),
+                Advance::Miss => None,
+                Advance::Continue(s) => {
+                    push(sc, t + s, a, b, RECHECK);
+                    None
+                }
+            }
+        };
+        (PAIR, s)
+    };
+    if let Some(s) = s {
+        if s > horizon || sc.cand.is_some_and(|c| t + s > c.time) {
+            return Ok(());
+        }
+        let (ca, cb) = (
+            w.critters.slot(a).expect("live"),
+            w.critters.slot(b).expect("live"),
+        );
+        let rule = w
+            .rules
+            .rule(&w.kinds, &w.topo, ca, cb)
+            .map_err(|e| at_step(e, w.step_count))?;
+        if rule == Some(PairRule::DontCollide) {
+            return Ok(());
+        }
+        if s == 0.0 && (just_met || sc.stuck.contains(&pair_key(a, b))) {
+            return Ok(()); // the pair was handled; its hook chose to leave them so
+        }
+        if s <= horizon {
+            push(sc, t + s, a, b, kind);
+        }
+    }
+    Ok(())
+}
+
+enum Advance {
+    Hit(f64),
+    Miss,
+    Continue(f64),
+}
+
+/// Conservative advancement on a gap function whose rate of change is bounded by `speed`:
+/// steps of gap / speed never pass the first contact.
+fn advance_to_contact(gap: impl Fn(f64) -> f64, speed: f64, horizon: f64, scale: f64) -> Advance {
+    let tol = 1e-11 * scale;
+    if speed <= 0.0 {
+        return Advance::Miss;
+    }
+    let mut s = 0.0;
+    for _ in 0..CA_ITERATIONS {
+        let g = gap(s);
+        if g <= tol {
+            return Advance::Hit(s);
+        }
+        s += g / speed;
+        if s > horizon {
+            return Advance::Miss;
+        }
+    }
+    Advance::Continue(s)
+}
+
+fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+    if w.topo.border == Border::Wrap {
+        return;
+    }
+    let c = w.critters.slot(a).expect("live slot");
+    let r = c.radius;
+    let (p, v, acc) = state_at(sc, a, t);
+    let just = sc.last[a as usize];
+    for axis in 0..V::DIM {
+        let lo = w.topo.min.get(axis) + r;
+        let hi = w.topo.max.get(axis) - r;
+        if lo > hi {
+            continue;
+        }
+        let (x, vx, ax) = (p.get(axis), v.get(axis), acc.get(axis));
+        for (side, bound) in [(0u32, lo), (1u32, hi)] {
+            let outward = if side == 1 { 1.0 } else { -1.0 };
+            // Distance to the bound, positive inside.
+            let gap = (bound - x) * outward;
+            let s = if gap <= 0.0 {
+                on_bound(vx * outward, ax * outward)
+            } else {
+                smallest_nonneg_root(0.5 * ax * outward, vx * outward, -gap)
+            };
+            let tag = axis as u32 * 2 + side;
+            if let Some(s) = s {
+                if s == 0.0 && just == BORDER_TAG + tag {
+                    continue;
+                }
+                if t + s <= sc.t_end {
+                    push(sc, t + s, a, tag, BORDER);
+                }
+            }
+        }
+    }
+}
+
+/// When a critter on (or a hair past) a bound leaves through it, given its outward velocity
+/// `v` and acceleration `a`: now if moving (or, at rest, accelerating) outward; after the
+/// parabola returns, `-2 v / a`, if moving inward but accelerated outward; never otherwise.
+fn on_bound(v: f64, a: f64) -> Option<f64> {
+    if v > 0.0 || (v == 0.0 && a > 0.0) {
+        Some(0.0)
+    } else if v < 0.0 && a > 0.0 {
+        Some(-2.0 * v / a)
+    } else {
+        None
+    }
+}
+
+fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
+    let (axis, side) = ((tag / 2) as usize, tag % 2);
+    let border = w.topo.border;
+    let (lo, hi) = (w.topo.min.get(axis), w.topo.max.get(axis));
+    let c = w.critters.slot_mut(a).expect("live slot");
+    let bound = if side == 1 {
+        hi - c.radius
+    } else {
+        lo + c.radius
+    };
+    c.pos.set(axis, bound);
+    let v = c.vel.get(axis);
+    let outward = if side == 1 { v > 0.0 } else { v < 0.0 };
+    if outward {
+        match border {
+            Border::Bounce => c.vel.set(axis, -c.restitution * v),
+            _ => c.vel.set(axis, 0.0),
+        }
+    }
+}
+
+#[allow(clippy::needless_range_loop)]
+fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+    let (p, v, acc) = state_at(sc, a, t);
+    let cc = coords(&sc.dims, sc.cell[a as usize] as usize);
+    let mut best = (f64::INFINITY, 0u32);
+    for axis in 0..V::DIM {
+        let n = sc.dims[axis] as i64;
+        if n == 1 {
+            continue;
+        }
+        let lo = w.topo.min.get(axis) + cc[axis] as f64 * sc.side[axis];
+        let hi = lo + sc.side[axis];
+        let (x, vx, ax) = (p.get(axis), v.get(axis), acc.get(axis));
+        for dir in [0u32, 1] {
+            let at_edge = if dir == 1 {
+                cc[axis] == n - 1
+            } else {
+                cc[axis] == 0
+            };
+            if at_edge && !w.topo.wraps() {
+                continue;
+            }
+            let outward = if dir == 1 { 1.0 } else { -1.0 };
+            let bound = if dir == 1 { hi } else { lo };
+            let gap = (bound - x) * outward;
+            let s = if gap <= 0.0 {
+                on_bound(vx * outward, ax * outward)
+            } else {
+                smallest_nonneg_root(0.5 * ax * outward, vx * outward, -gap)
+            };
+            if let Some(s) = s {
+                if s < best.0 {
+                    best = (s, axis as u32 * 2 + dir);
+                }
+            }
+        }
+    }
+    if best.0.is_finite() && t + best.0 <= sc.t_end {
+        push(sc, t + best.0, a, best.1, CELL);
+    }
+}
+
+#[allow(clippy::needless_range_loop)]
+fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32, t: f64) {
+    advance(w, sc, a, t);
+    let (axis, dir) = ((tag / 2) as usize, tag % 2);
+    let old = sc.cell[a as usize] as usize;
+    let mut cc = coords(&sc.dims, old);
+    cc[axis] += if dir == 1 { 1 } else { -1 };
+    let n = sc.dims[axis] as i64;
+    if w.topo.wraps() && (cc[axis] < 0 || cc[axis] >= n) {
+        let len = w.topo.size().get(axis);
+        let c = w.critters.slot_mut(a).expect("live slot");
+        let x = c.pos.get(axis);
+        c.pos.set(axis, if dir == 1 { x - len } else { x + len });
+    }
+    let new = key(&sc.dims, cc);
+    move_cell(sc, a, old, new);
+}
+
+fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize) {
+    if old == new {
+        return;
+    }
+    if let Some(i) = sc.cells[old].iter().position(|&x| x == a) {
+        sc.cells[old].swap_remove(i);
+    }
+    sc.cells[new].push(a);
+    sc.cell[a as usize] = new as u32;
+}
+
+/// After a hook ran: the critter may have died or been moved; put it in the right cell.
+fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
+    let old = sc.cell[a as usize] as usize;
+    let Some(c) = w.critters.slot(a) else { return };
+    if !c.alive {
+        if let Some(i) = sc.cells[old].iter().position(|&x| x == a) {
+            sc.cells[old].swap_remove(i);
+        }
+        return;
+    }
+    let mut p = c.pos;
+    if w.topo.wraps() {
+        p = w.topo.wrap_position(p);
+        w.critters.slot_mut(a).expect("live").pos = p;
+    }
+    let new = cell_of(w, sc, p);
+    move_cell(sc, a, old, new);
+}
+
+/// Hands a touching pair to the caller's `collide` hook (Pop's roles), with the TC model.
+fn collide<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    b: u32,
+    t: f64,
+) -> Result<bool, Error> {
+    let (ca, cb) = (
+        w.critters.slot(a).expect("live"),
+        w.critters.slot(b).expect("live"),
+    );
+    let rule = match w
+        .rules
+        .rule(&w.kinds, &w.topo, ca, cb)
+        .map_err(|e| at_step(e, w.step_count))?
+    {
+        Some(r) => r,
+        None => crate::rules::roles_of(&w.kinds, &w.topo, ca, cb)
+            .map_err(|e| at_step(e, w.step_count))?,
+    };
+    let Some((caller, arg)) = roles_order(rule, ca, cb) else {
+        return Ok(false);
+    };
+    let (caller, arg) = (caller.id.index, arg.id.index);
+    // TC model: a collision right after another one of either critter is elastic.
+    let recent = |x: u32| t - sc.last_t[x as usize] < sc.tc;
+    let tc = recent(a) || (!cb.is_wall() && recent(b));
+    let saved = if tc {
+        let e = [a, b].map(|x| w.critters.slot(x).map_or(1.0, |c| c.restitution));
+        for x in [a, b] {
+            if let Some(c) = w.critters.slot_mut(x) {
+                c.restitution = 1.0;
+            }
+        }
+        Some(e)
+    } else {
+        None
+    };
+    let before = w.events.collisions.len();
+    let out = w.collide_pair(caller, arg);
+    if let Some(e) = saved {
+        for (x, e) in [a, b].into_iter().zip(e) {
+            if let Some(c) = w.critters.slot_mut(x) {
+                if c.restitution == 1.0 {
+                    c.restitution = e;
+                }
+            }
+        }
+    }
+    for ev in &w.events.collisions[before..] {
+        let (Some(c1), Some(c2)) = (w.critters.get(ev.caller), w.critters.get(ev.arg)) else {
+            continue;
+        };
+        if !c1.is_wall() && !c2.is_wall() {
+            sc.virial += (c1.radius + c2.radius) * ev.impulse;
+        }
+    }
+    out
+}
+
+impl<V: Vector> World<V> {
+    /// The collision virial of the last event or swept step: the sum over disk-disk default
+    /// collisions of contact distance x impulse (for pressure, `docs/methods.md`).
+    pub fn collision_virial(&self) -> f64 {
+        self.flight.virial
+    }
+}

@@ -1,0 +1,433 @@
+//! The stability suite's stress scenes, written once for the tests, the benches, `critterbox
+//! stability` and `critterbox chart`. Each scene runs under a [`Method`] and returns a measured
+//! error (0 is perfect; what it measures is in [`STRESS`] and `docs/stability.md`).
+
+use crate::border::Border;
+use crate::critter::{CritterId, CritterSpec};
+use crate::error::Error;
+use crate::method::Method;
+use crate::vector::Vector;
+use crate::wall::WallBox;
+use crate::world::{World, WorldConfig};
+use glam::DVec2;
+
+/// One stress scene.
+pub struct Stress {
+    /// Name.
+    pub name: &'static str,
+    /// What the error measures.
+    pub error: &'static str,
+    /// Runs the scene under a method.
+    pub run: fn(Method) -> Result<f64, Error>,
+}
+
+/// The stress scenes (the bullet is swept over speeds separately: [`bullet`]).
+pub const STRESS: &[Stress] = &[
+    Stress {
+        name: "cradle",
+        error: "momentum left outside the last ball, relative",
+        run: cradle,
+    },
+    Stress {
+        name: "resting pile",
+        error: "largest relative rise of total energy (kinetic + potential) over 2 s",
+        run: resting_pile,
+    },
+    Stress {
+        name: "mass ratios 1e-6..1e6",
+        error: "worst relative error in momentum or kinetic energy (inf for NaN)",
+        run: mass_ratios,
+    },
+    Stress {
+        name: "dense pack 0.7",
+        error: "deepest overlap at a step's end, in radii",
+        run: dense_pack,
+    },
+    Stress {
+        name: "spawned on top",
+        error: "deepest overlap after 30 steps, in radii (inf for NaN)",
+        run: spawned_on_top,
+    },
+    Stress {
+        name: "restitution 0.5 column",
+        error: "largest relative rise of total energy; deepest overlap in radii (the larger)",
+        run: collapse_column,
+    },
+    Stress {
+        name: "glancing hits",
+        error: "worst angle error of the outgoing velocities against the exact 90 degrees (rad)",
+        run: glancing,
+    },
+];
+
+const DT: f64 = 1.0 / 60.0;
+
+fn world2(min: DVec2, max: DVec2, method: Method) -> Result<World<DVec2>, Error> {
+    World::new(WorldConfig::new(min, max).dt(DT).method(method))
+}
+
+/// The bullet: a disk of radius 0.05 at `speed` towards a wall 0.02 thick, dt = 1/60. Returns
+/// true when it ends up past the wall (tunnelled) at any step's end.
+pub fn bullet(speed: f64, method: Method) -> Result<bool, Error> {
+    let mut w = world2(DVec2::ZERO, DVec2::new(100.0, 10.0), method)?;
+    let wall_x = 50.0;
+    w.add_wall(WallBox::segment(
+        DVec2::new(wall_x, 0.0),
+        DVec2::new(wall_x, 10.0),
+        0.02,
+    )?)?;
+    let b = w.spawn(
+        CritterSpec::ball(DVec2::new(10.0, 5.0))
+            .vel(DVec2::new(speed, 0.0))
+            .radius(0.05),
+    )?;
+    let steps = ((40.0 / (speed * DT)).ceil() as u64 + 2).min(100_000);
+    for _ in 0..steps {
+        w.step()?;
+        let x = w.get(b).map_or(f64::NAN, |c| c.pos.x);
+        if x >= wall_x || x.is_nan() {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// Speeds of the bullet sweep: 1 to 1e6, four per decade.
+pub fn bullet_speeds() -> Vec<f64> {
+    (0..=24).map(|i| 10f64.powf(i as f64 / 4.0)).collect()
+}
+
+fn cradle(method: Method) -> Result<f64, Error> {
+    let r = 0.5;
+    let mut w = world2(DVec2::ZERO, DVec2::new(40.0, 4.0), method)?;
+    let v0 = 1.0;
+    let mut ids = vec![w.spawn(
+        CritterSpec::ball(DVec2::new(2.0, 2.0))
+            .vel(DVec2::new(v0, 0.0))
+            .radius(r),
+    )?];
+    for i in 0..5 {
+        ids.push(w.spawn(CritterSpec::ball(DVec2::new(5.0 + 2.0 * r * i as f64, 2.0)).radius(r))?);
+    }
+    w.run(180)?; // 3 s: the striker arrives at 2 s
+    let last = w.get(ids[5]).map_or(f64::NAN, |c| c.vel.x);
+    let others: f64 = ids[..5]
+        .iter()
+        .map(|&id| w.get(id).map_or(f64::NAN, |c| c.vel.length()))
+        .sum();
+    Ok(((last - v0).abs() + others) / v0)
+}
+
+fn total_energy<V: Vector>(w: &World<V>) -> f64 {
+    let g = w.gravity();
+    w.critters()
+        .iter()
+        .filter(|c| !c.is_fixed())
+        .map(|c| c.kinetic_energy() - c.mass() * g.dot(c.pos))
+        .sum()
+}
+
+fn max_overlap<V: Vector>(w: &World<V>) -> f64 {
+    let cs: Vec<_> = w
+        .critters()
+        .iter()
+        .filter(|c| c.is_alive() && !c.is_wall())
+        .collect();
+    let mut worst: f64 = 0.0;
+    for (i, a) in cs.iter().enumerate() {
+        for b in &cs[i + 1..] {
+            let d = w.topology().delta(a.pos, b.pos).length();
+            let depth = (a.radius() + b.radius() - d) / a.radius().min(b.radius());
+            if depth.is_nan() {
+                return f64::INFINITY;
+            }
+            worst = worst.max(depth);
+        }
+    }
+    worst
+}
+
+fn floor_box(method: Method) -> Result<World<DVec2>, Error> {
+    let mut w = World::new(
+        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(11.0, 30.0))
+            .dt(DT)
+            .gravity(DVec2::new(0.0, -9.81))
+            .method(method),
+    )?;
+    let t = 0.2;
+    w.add_wall(WallBox::aligned(
+        DVec2::new(-t, -t),
+        DVec2::new(10.0 + t, 0.0),
+    )?)?;
+    w.add_wall(WallBox::aligned(
+        DVec2::new(-t, 0.0),
+        DVec2::new(0.0, 25.0),
+    )?)?;
+    w.add_wall(WallBox::aligned(
+        DVec2::new(10.0, 0.0),
+        DVec2::new(10.0 + t, 25.0),
+    )?)?;
+    Ok(w)
+}
+
+fn resting_pile(method: Method) -> Result<f64, Error> {
+    let mut w = floor_box(method)?;
+    // Three rows of touching balls resting on the floor (a hair apart), restitution 0.5.
+    let r = 0.5;
+    for row in 0..3 {
+        for k in 0..9 {
+            let x = 0.5 + r + k as f64 * (2.0 * r + 1e-6) + if row % 2 == 1 { r } else { 0.0 };
+            if x > 10.0 - r {
+                continue;
+            }
+            let y = r + 1e-6 + row as f64 * (2.0 * r * 0.866_025_4 + 1e-6);
+            w.spawn(
+                CritterSpec::ball(DVec2::new(x, y))
+                    .radius(r)
+                    .restitution(0.5),
+            )?;
+        }
+    }
+    let e0 = total_energy(&w);
+    let scale = w
+        .critters()
+        .iter()
+        .map(|c| c.mass())
+        .filter(|m| m.is_finite())
+        .sum::<f64>()
+        * 9.81
+        * 1.0;
+    let mut worst: f64 = 0.0;
+    for _ in 0..120 {
+        w.step()?;
+        let e = total_energy(&w);
+        if !e.is_finite() {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max((e - e0) / scale);
+    }
+    Ok(worst)
+}
+
+fn mass_ratios(method: Method) -> Result<f64, Error> {
+    let mut worst: f64 = 0.0;
+    for k in -6..=6 {
+        let ratio = 10f64.powi(k);
+        let mut w = world2(DVec2::ZERO, DVec2::new(40.0, 10.0), method)?;
+        let a = w.spawn(
+            CritterSpec::ball(DVec2::new(5.0, 5.0))
+                .vel(DVec2::new(3.0, 0.4))
+                .mass(1.0),
+        )?;
+        let b = w.spawn(
+            CritterSpec::ball(DVec2::new(12.0, 5.3))
+                .vel(DVec2::new(-2.0, 0.0))
+                .mass(ratio),
+        )?;
+        let (p0, e0) = (w.momentum(), w.kinetic_energy());
+        w.run(90)?;
+        let (p, e) = (w.momentum(), w.kinetic_energy());
+        let hit = w.get(a).map(|c| c.vel) != Some(DVec2::new(3.0, 0.4))
+            || w.get(b).map(|c| c.vel) != Some(DVec2::new(-2.0, 0.0));
+        let pscale = 3.0f64.hypot(0.4) + 2.0 * ratio;
+        let err = ((p - p0).length() / pscale).max((e - e0).abs() / e0);
+        if !err.is_finite() || !hit {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max(err);
+    }
+    Ok(worst)
+}
+
+fn dense_pack(method: Method) -> Result<f64, Error> {
+    // 400 disks at packing fraction 0.7 in a periodic box: a hexagonal lattice, shaken.
+    let (nx, ny) = (20usize, 20usize);
+    let r = 0.5;
+    let phi: f64 = 0.7;
+    let area = (nx * ny) as f64 * std::f64::consts::PI * r * r / phi;
+    let aspect = 3f64.sqrt() / 2.0;
+    let lx = (area / aspect).sqrt();
+    let ly = area / lx;
+    let mut w = World::new(
+        WorldConfig::new(DVec2::ZERO, DVec2::new(lx, ly))
+            .border(Border::Wrap)
+            .dt(DT)
+            .method(method)
+            .seed(3),
+    )?;
+    let (sx, sy) = (lx / nx as f64, ly / ny as f64);
+    for j in 0..ny {
+        for i in 0..nx {
+            let x = (i as f64 + 0.25 + 0.5 * (j % 2) as f64) * sx;
+            let y = (j as f64 + 0.5) * sy;
+            let v = DVec2::new(w.rng().uniform(-1.0, 1.0), w.rng().uniform(-1.0, 1.0));
+            w.spawn(CritterSpec::ball(DVec2::new(x, y)).vel(v * 3.0).radius(r))?;
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for _ in 0..60 {
+        w.step()?;
+        worst = worst.max(max_overlap(&w));
+    }
+    Ok(worst)
+}
+
+fn spawned_on_top(method: Method) -> Result<f64, Error> {
+    let mut w = world2(DVec2::ZERO, DVec2::new(20.0, 20.0), method)?;
+    for i in 0..8 {
+        // Exactly on top of each other, and a hair apart.
+        let off = if i % 2 == 0 { 0.0 } else { 1e-9 * i as f64 };
+        w.spawn(CritterSpec::ball(DVec2::new(10.0 + off, 10.0)).radius(0.5))?;
+    }
+    w.run(30)?;
+    let any_nan = w.critters().iter().any(|c| !c.pos.is_finite());
+    Ok(if any_nan {
+        f64::INFINITY
+    } else {
+        max_overlap(&w)
+    })
+}
+
+fn collapse_column(method: Method) -> Result<f64, Error> {
+    let mut w = floor_box(method)?;
+    let r = 0.25;
+    let mut ids: Vec<CritterId> = Vec::new();
+    for k in 0..6 {
+        ids.push(
+            w.spawn(
+                CritterSpec::ball(DVec2::new(5.0, 1.0 + k as f64 * 0.6))
+                    .radius(r)
+                    .restitution(0.5),
+            )?,
+        );
+    }
+    let e0 = total_energy(&w);
+    let scale = e0.abs().max(1.0);
+    let mut worst: f64 = 0.0;
+    for _ in 0..180 {
+        w.step()?;
+        let e = total_energy(&w);
+        if !e.is_finite() {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max((e - e0) / scale).max(max_overlap(&w));
+    }
+    Ok(worst)
+}
+
+fn glancing(method: Method) -> Result<f64, Error> {
+    let mut worst: f64 = 0.0;
+    for k in 1..10 {
+        let b = k as f64 * 0.1; // impact parameter in diameters
+        let mut w = world2(DVec2::ZERO, DVec2::new(60.0, 60.0), method)?;
+        let a = w.spawn(
+            CritterSpec::ball(DVec2::new(10.0, 30.0))
+                .vel(DVec2::new(20.0, 0.0))
+                .radius(0.5),
+        )?;
+        let t = w.spawn(CritterSpec::ball(DVec2::new(20.0, 30.0 + b)).radius(0.5))?;
+        w.run(40)?;
+        let (va, vt) = (w.get(a).map(|c| c.vel), w.get(t).map(|c| c.vel));
+        let (Some(va), Some(vt)) = (va, vt) else {
+            return Ok(f64::INFINITY);
+        };
+        // Exact: the target leaves along the line of centres at contact, at angle asin(b)
+        // above the x axis; the striker at right angles to it.
+        let want = b.asin();
+        let got = vt.y.atan2(vt.x);
+        let right = (va.dot(vt) / (va.length() * vt.length())).acos();
+        let err = (got - want)
+            .abs()
+            .max((right - std::f64::consts::FRAC_PI_2).abs());
+        if !err.is_finite() {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max(err);
+    }
+    Ok(worst)
+}
+
+/// The methods the suite compares.
+pub const METHODS: [Method; 5] = [
+    Method::Discrete,
+    Method::Substep(8),
+    Method::Swept,
+    Method::Event,
+    Method::Auto,
+];
+
+/// The slowest bullet speed (of [`bullet_speeds`]) that tunnels under `method`, if any.
+pub fn first_tunnelling_speed(method: Method) -> Result<Option<f64>, Error> {
+    for v in bullet_speeds() {
+        if bullet(v, method)? {
+            return Ok(Some(v));
+        }
+    }
+    Ok(None)
+}
+
+/// One point of the speed-against-accuracy chart.
+#[derive(Clone, Debug)]
+pub struct ChartPoint {
+    /// The method.
+    pub method: Method,
+    /// The time step.
+    pub dt: f64,
+    /// Wall time per simulated second per critter (seconds).
+    pub cost: f64,
+    /// Root-mean-square position error against the event-driven reference, in radii.
+    pub error: f64,
+}
+
+/// The chart's scene: 100 disks of radius 0.5 at packing fraction 0.3 in a walled box, speeds
+/// up to 6 per axis, one simulated second.
+fn chart_gas(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
+    let mut w = crate::scenes::gas::<DVec2>(&crate::scenes::GasParams {
+        n: 100,
+        packing: 0.3,
+        dt,
+        seed: 7,
+        ..Default::default()
+    })?;
+    let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id()).collect();
+    for id in ids {
+        if let Some(c) = w.get_mut(id) {
+            c.vel *= 6.0;
+        }
+    }
+    w.set_method(method)?;
+    Ok(w)
+}
+
+/// Runs the chart's sweep: each method at dt = 1/15 ... 1/960 over one simulated second, error
+/// against the event method at dt = 1 (one step: no step boundaries at all).
+pub fn chart_points(methods: &[Method]) -> Result<Vec<ChartPoint>, Error> {
+    let mut reference = chart_gas(Method::Event, 1.0)?;
+    reference.step()?;
+    let want: Vec<DVec2> = reference.critters().iter().map(|c| c.pos).collect();
+    let mut out = Vec::new();
+    for &method in methods {
+        for k in 0..7 {
+            let dt = 1.0 / (15.0 * 2f64.powi(k));
+            let mut w = chart_gas(method, dt)?;
+            let steps = (1.0 / dt).round() as u64;
+            let n = w.critters().iter().filter(|c| !c.is_wall()).count() as f64;
+            let start = std::time::Instant::now();
+            w.run(steps)?;
+            let cost = start.elapsed().as_secs_f64() / n;
+            let mut sum = 0.0;
+            for (c, p) in w.critters().iter().zip(&want) {
+                if !c.is_wall() {
+                    sum += (c.pos - *p).length_squared() / (c.radius() * c.radius());
+                }
+            }
+            out.push(ChartPoint {
+                method,
+                dt,
+                cost,
+                error: (sum / n).sqrt(),
+            });
+        }
+    }
+    Ok(out)
+}
