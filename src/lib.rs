@@ -42,6 +42,8 @@ pub mod script;
 pub mod stability;
 
 pub mod vector;
+#[cfg(feature = "rerun")]
+pub mod viewer;
 pub mod wall;
 pub mod world;
 

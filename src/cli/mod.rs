@@ -13,6 +13,7 @@ pub mod replay;
 pub mod run;
 pub mod stability;
 pub mod test;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 

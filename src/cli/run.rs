@@ -57,6 +57,9 @@ pub struct RunArgs {
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
+    /// Watching the run.
+    #[command(flatten)]
+    pub view: super::view::ViewArgs,
     /// Recording options.
     #[command(flatten)]
     pub recording: RecordArgs,
@@ -94,6 +97,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
 
     let energy0 = scene.world.kinetic_energy();
     let momentum0 = scene.world.momentum();
+    let mut viewer = super::view::Viewer::open(&args.view, &scene.world)?;
     // Recording: started before the first step, fed after each one, closed at the end.
     let mut recorder = record::start(args, &scene, steps)?;
     record::watch_ctrl_c();
@@ -107,7 +111,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             break;
         }
         let step = scene.world.step_count();
+        let step_started = Instant::now();
         let outcome = scene.step();
+        viewer.step(&scene.world, step_started.elapsed());
         let log = scene.world.log();
         if !log.is_empty() {
             bar.suspend(|| {
@@ -138,8 +144,17 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     }
     let wall = started.elapsed();
     bar.finish_and_clear();
+    let viewing = viewer.finish();
     let done = scene.world.step_count();
     summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
+    if let Some(spent) = viewing {
+        writeln!(
+            out,
+            "viewer       {:.3} s logging to Rerun ({:.1}% of the run)",
+            spent.as_secs_f64(),
+            100.0 * spent.as_secs_f64() / wall.as_secs_f64().max(1e-9)
+        )?;
+    }
     let method = scene.world.method();
     writeln!(out, "method       {method}")?;
     if let Some((chose, why)) = scene.world.auto_choice() {
