@@ -160,22 +160,14 @@ impl<V: Vector> Access<'_, V> {
     /// True when `a` and `b` touch now.
     pub fn touches_pair(&self, a: CritterId, b: CritterId) -> bool {
         match (self.critters.get(a), self.critters.get(b)) {
-            (Some(a), Some(b)) if a.id != b.id => {
-                response::contact_between(self.topo, a, b).is_some()
-            }
+            (Some(a), Some(b)) => response::touches(self.topo, a, b),
             _ => false,
         }
     }
     /// Pop's `contains`: `inner` lies wholly inside `outer` (disks only).
     pub fn contains_pair(&self, outer: CritterId, inner: CritterId) -> bool {
         match (self.critters.get(outer), self.critters.get(inner)) {
-            (Some(o), Some(i)) if o.id != i.id && !o.is_wall() && !i.is_wall() => {
-                crate::contact::contains_ball_ball(
-                    self.topo.delta(o.pos, i.pos),
-                    o.radius,
-                    i.radius,
-                )
-            }
+            (Some(o), Some(i)) => response::contains(self.topo, o, i),
             _ => false,
         }
     }

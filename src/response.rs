@@ -47,6 +47,23 @@ pub fn contact_between<V: Vector>(
     }
 }
 
+/// True when two different critters touch now.
+pub fn touches<V: Vector>(topo: &Topology<V>, a: &Critter<V>, b: &Critter<V>) -> bool {
+    a.id != b.id && contact_between(topo, a, b).is_some()
+}
+
+/// Pop's `contains`: disk `inner` lies wholly inside disk `outer` (false for walls).
+pub fn contains<V: Vector>(topo: &Topology<V>, outer: &Critter<V>, inner: &Critter<V>) -> bool {
+    outer.id != inner.id
+        && !outer.is_wall()
+        && !inner.is_wall()
+        && crate::contact::contains_ball_ball(
+            topo.delta(outer.pos, inner.pos),
+            outer.radius,
+            inner.radius,
+        )
+}
+
 /// Applies the impulse and separation for a contact `c` (normal from `caller` to `arg`).
 ///
 /// Returns the impulse magnitude given to `arg` along the normal.

@@ -24,7 +24,6 @@ pub(crate) trait Env<V: Vector> {
     fn critter(&self, id: CritterId) -> Option<&Critter<V>>;
     fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>>;
     fn kinds(&self) -> &KindSet<V>;
-    #[allow(dead_code)] // part of the contract; scripts reach the box through `world()` later
     fn topology(&self) -> &Topology<V>;
     fn step_count(&self) -> u64;
     fn time(&self) -> f64;
@@ -36,9 +35,22 @@ pub(crate) trait Env<V: Vector> {
     fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error>;
     fn log(&mut self, line: String);
     fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
-    fn touches(&self, a: CritterId, b: CritterId) -> bool;
-    fn contains(&self, outer: CritterId, inner: CritterId) -> bool;
-    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64>;
+    fn touches(&self, a: CritterId, b: CritterId) -> bool {
+        match (self.critter(a), self.critter(b)) {
+            (Some(x), Some(y)) => crate::response::touches(self.topology(), x, y),
+            _ => false,
+        }
+    }
+    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
+        match (self.critter(outer), self.critter(inner)) {
+            (Some(o), Some(i)) => crate::response::contains(self.topology(), o, i),
+            _ => false,
+        }
+    }
+    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
+        let (x, y) = (self.critter(a)?, self.critter(b)?);
+        Some(self.topology().delta(x.pos, y.pos).length())
+    }
     /// The default response; `Err` outside a step.
     fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
     /// The world itself, between steps (scene setup and `on_step`).
@@ -99,27 +111,6 @@ impl<V: Vector> Env<V> for World<V> {
             .map(|c| c.id())
             .collect()
     }
-    fn touches(&self, a: CritterId, b: CritterId) -> bool {
-        match (self.get(a), self.get(b)) {
-            (Some(x), Some(y)) if a != b => {
-                crate::response::contact_between(World::topology(self), x, y).is_some()
-            }
-            _ => false,
-        }
-    }
-    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
-        match (self.get(outer), self.get(inner)) {
-            (Some(o), Some(i)) if outer != inner && !o.is_wall() && !i.is_wall() => {
-                let d = World::topology(self).delta(o.pos, i.pos);
-                crate::contact::contains_ball_ball(d, o.radius(), i.radius())
-            }
-            _ => false,
-        }
-    }
-    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
-        let (x, y) = (self.get(a)?, self.get(b)?);
-        Some(World::topology(self).delta(x.pos, y.pos).length())
-    }
     fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
         Err("collide_default can only be called inside a collide hook".into())
     }
@@ -168,15 +159,6 @@ impl<V: Vector> Env<V> for Access<'_, V> {
     }
     fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
         Access::critters_of(self, kind)
-    }
-    fn touches(&self, a: CritterId, b: CritterId) -> bool {
-        self.touches_pair(a, b)
-    }
-    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
-        self.contains_pair(outer, inner)
-    }
-    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
-        self.distance_pair(a, b)
     }
     fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String> {
         Ok(self.collide_default_pair(caller, arg).is_some())

@@ -520,30 +520,6 @@ impl<V: Vector> Env<V> for PairView<'_, V> {
     fn critters_of(&self, _kind: KindId) -> Vec<CritterId> {
         Vec::new()
     }
-    fn touches(&self, a: CritterId, b: CritterId) -> bool {
-        match (self.critter(a), self.critter(b)) {
-            (Some(x), Some(y)) if a != b => {
-                crate::response::contact_between(self.topo, x, y).is_some()
-            }
-            _ => false,
-        }
-    }
-    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
-        match (self.critter(outer), self.critter(inner)) {
-            (Some(o), Some(i)) if outer != inner && !o.is_wall() && !i.is_wall() => {
-                crate::contact::contains_ball_ball(
-                    self.topo.delta(o.pos, i.pos),
-                    o.radius(),
-                    i.radius(),
-                )
-            }
-            _ => false,
-        }
-    }
-    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
-        let (x, y) = (self.critter(a)?, self.critter(b)?);
-        Some(self.topo.delta(x.pos, y.pos).length())
-    }
     fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
         Err("collide_default belongs in collide, not collides_with".into())
     }

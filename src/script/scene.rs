@@ -289,14 +289,8 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
               count: INT,
               map: Map|
               -> Res<Array> {
-            ensure_kind(&h, kind)?;
-            let mut out = Array::new();
-            for i in 0..count.max(0) {
-                let mut m = map.clone();
-                m.insert("pos".into(), Dynamic::from(start + step * i as f64));
-                out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
-            }
-            Ok(out)
+            let positions = (0..count.max(0)).map(|i| start + step * i as f64);
+            spawn_at(&h, kind, &map, positions)
         },
     );
     let h = host.clone();
@@ -309,19 +303,12 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
               count: INT,
               map: Map|
               -> Res<Array> {
-            ensure_kind(&h, kind)?;
             let r = num_or(&radius, "ring radius")?;
-            let mut out = Array::new();
-            for i in 0..count.max(0) {
+            let positions = (0..count.max(0)).map(|i| {
                 let a = std::f64::consts::TAU * i as f64 / count as f64;
-                let mut m = map.clone();
-                m.insert(
-                    "pos".into(),
-                    Dynamic::from(center + DVec3::new(r * a.cos(), r * a.sin(), 0.0)),
-                );
-                out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
-            }
-            Ok(out)
+                center + DVec3::new(r * a.cos(), r * a.sin(), 0.0)
+            });
+            spawn_at(&h, kind, &map, positions)
         },
     );
     let h = host.clone();
@@ -334,7 +321,6 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
               spacing: Dynamic,
               map: Map|
               -> Res<Array> {
-            ensure_kind(&h, kind)?;
             let s = num_or(&spacing, "grid spacing")?;
             if !(s > 0.0 && s.is_finite()) {
                 return fail(format!("grid spacing {s} must be a finite number > 0"));
@@ -349,18 +335,12 @@ pub(crate) fn register(engine: &mut Engine, host: &Rc<Host>) {
             if nx * ny * nz > 10_000_000 {
                 return fail("that grid would hold more than 10 million critters");
             }
-            let mut out = Array::new();
-            for k in 0..nz {
-                for j in 0..ny {
-                    for i in 0..nx {
-                        let mut m = map.clone();
-                        let p = lo + DVec3::new(i as f64 * s, j as f64 * s, k as f64 * s);
-                        m.insert("pos".into(), Dynamic::from(p));
-                        out.push(with_env!(h, env => spawn_in(env, &h, kind, &m))?);
-                    }
-                }
-            }
-            Ok(out)
+            let positions = (0..nz).flat_map(|k| {
+                (0..ny).flat_map(move |j| {
+                    (0..nx).map(move |i| lo + DVec3::new(i as f64 * s, j as f64 * s, k as f64 * s))
+                })
+            });
+            spawn_at(&h, kind, &map, positions)
         },
     );
     let h = host.clone();
@@ -444,6 +424,23 @@ fn rotated_box<V: Vector>(center: V, size: DVec3, rot: DMat3) -> Res<WallBox<V>>
     };
     let frame = frame.map_or_else(|| fail("cannot orient that wall"), Ok)?;
     WallBox::new(center, from_svec::<V>(size) * 0.5, frame).map_err(lib_err)
+}
+
+/// One critter of `kind` at each position, with the rest of `map` (the kind loads on first use).
+fn spawn_at(
+    host: &Rc<Host>,
+    kind: &str,
+    map: &Map,
+    positions: impl Iterator<Item = DVec3>,
+) -> Res<Array> {
+    ensure_kind(host, kind)?;
+    let mut out = Array::new();
+    for p in positions {
+        let mut m = map.clone();
+        m.insert("pos".into(), Dynamic::from(p));
+        out.push(with_env!(host, env => spawn_in(env, host, kind, &m))?);
+    }
+    Ok(out)
 }
 
 /// One critter at a random free place in the world box (seeded), clear of walls and critters.
