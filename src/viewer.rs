@@ -17,6 +17,10 @@ use crate::world::World;
 use rerun::RecordingStream;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::sync::Arc;
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// Where the viewer data goes.
@@ -33,14 +37,28 @@ pub enum RerunTarget {
 /// Velocity arrows are drawn by default up to this many critters.
 pub const ARROWS_UP_TO: usize = 2_000;
 
+/// Steps the logging thread may be behind before a live viewer skips one.
+const QUEUE: usize = 4;
+
 /// Streams a run to Rerun.
 pub struct RerunSink {
     rec: RecordingStream,
     target: RerunTarget,
     arrows: bool,
     labels: bool,
+    /// Time taken from the simulation thread.
     logging: Duration,
-    kinds_seen: BTreeMap<String, ()>,
+    /// Steps not sent to a live viewer because the logging thread was behind.
+    skipped: u64,
+    tx: Option<SyncSender<Frame>>,
+    /// Frames sent and not yet drawn: a live viewer's step is skipped before it is copied when
+    /// the queue is full.
+    in_flight: Arc<AtomicUsize>,
+    /// Frames the logging thread is done with, to be filled again (no allocation per step).
+    spare: Option<Receiver<Frame>>,
+    /// Told when the logging thread has drawn everything.
+    done: Option<Receiver<()>>,
+    thread: Option<JoinHandle<()>>,
 }
 
 /// A colour for a kind: its `color` default if it names one we know, else one from a palette.
@@ -103,18 +121,63 @@ impl RerunSink {
             arrows: critters <= ARROWS_UP_TO,
             labels: critters <= ARROWS_UP_TO,
             logging: Duration::ZERO,
-            kinds_seen: BTreeMap::new(),
+            skipped: 0,
+            tx: None,
+            in_flight: Arc::new(AtomicUsize::new(0)),
+            spare: None,
+            done: None,
+            thread: None,
         })
     }
 
-    /// Turns velocity arrows on or off.
+    /// Turns velocity arrows on or off (before the first step is logged).
     pub fn set_arrows(&mut self, on: bool) {
         self.arrows = on;
     }
 
-    /// Time spent logging so far (the cost to the simulation).
+    /// Starts the logging thread on the first step.
+    fn start(&mut self) {
+        if self.tx.is_some() || self.thread.is_some() {
+            return;
+        }
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Frame>(QUEUE);
+        let (give_back, spare) = std::sync::mpsc::channel::<Frame>();
+        let (finished, done) = std::sync::mpsc::channel::<()>();
+        let in_flight = Arc::clone(&self.in_flight);
+        let mut drawer = Drawer {
+            rec: self.rec.clone(),
+            arrows: self.arrows,
+            labels: self.labels,
+            kinds: BTreeMap::new(),
+        };
+        match std::thread::Builder::new()
+            .name("critterbox-rerun".into())
+            .spawn(move || {
+                for frame in rx {
+                    drawer.draw(&frame);
+                    in_flight.fetch_sub(1, Ordering::AcqRel);
+                    let _ = give_back.send(frame);
+                }
+                let _ = finished.send(());
+            }) {
+            Ok(thread) => {
+                self.tx = Some(tx);
+                self.spare = Some(spare);
+                self.done = Some(done);
+                self.thread = Some(thread);
+            }
+            Err(e) => eprintln!("warning: no Rerun logging thread ({e}); nothing more is logged"),
+        }
+    }
+
+    /// Time taken from the simulation thread so far (the cost to the run).
     pub fn logging_time(&self) -> Duration {
         self.logging
+    }
+
+    /// Steps a live viewer did not get because the logging thread was behind.
+    pub fn skipped(&self) -> u64 {
+        self.skipped
     }
 
     /// Logs walls and the border, once, as static data.
@@ -194,73 +257,307 @@ impl RerunSink {
         }
     }
 
-    /// Logs the state after a step that took `step_time` to compute.
+    /// Logs the state after a step that took `step_time` to compute. On this (the simulation's)
+    /// thread only a compact copy of the step is taken; the logging thread builds what Rerun
+    /// gets from it.
     pub fn log_step(&mut self, world: &AnyWorld, step_time: Duration) {
         let started = Instant::now();
-        match world {
-            AnyWorld::D2(w) => self.step_generic(w, step_time),
-            AnyWorld::D3(w) => self.step_generic(w, step_time),
+        self.start();
+        let live = !matches!(self.target, RerunTarget::Save(_));
+        if live && self.tx.is_some() && self.in_flight.load(Ordering::Acquire) >= QUEUE {
+            // A live viewer never holds the run up: the logging thread is behind, so this step
+            // is not even copied.
+            self.skipped += 1;
+            self.logging += started.elapsed();
+            return;
         }
+        let mut frame = self
+            .spare
+            .as_ref()
+            .and_then(|r| r.try_recv().ok())
+            .unwrap_or_else(Frame::empty);
+        match world {
+            AnyWorld::D2(w) => frame.fill(w, step_time),
+            AnyWorld::D3(w) => frame.fill(w, step_time),
+        }
+        self.send(frame);
         self.logging += started.elapsed();
     }
 
-    fn step_generic<V: Vector>(&mut self, w: &World<V>, step_time: Duration) {
-        let rec = &self.rec;
-        rec.set_time_sequence("step", w.step_count() as i64);
-        rec.set_duration_secs("sim_time", w.time());
-        let kinds = w.kinds();
-        // Group critters by kind, in id order.
-        let mut by_kind: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-        let critters: Vec<_> = w
-            .critters()
-            .iter()
-            .filter(|c| c.is_alive() && !c.is_wall())
-            .collect();
-        for (i, c) in critters.iter().enumerate() {
-            by_kind
-                .entry(kinds.name(c.kind()).to_string())
-                .or_default()
-                .push(i);
+    fn send(&mut self, frame: Frame) {
+        let Some(tx) = &self.tx else { return };
+        self.in_flight.fetch_add(1, Ordering::AcqRel);
+        if matches!(self.target, RerunTarget::Save(_)) {
+            // A file gets every step: wait for the logging thread if it is behind.
+            if tx.send(frame).is_err() {
+                self.tx = None;
+            }
+            return;
         }
+        // A live viewer never holds the run up: a step the logging thread has no room for is
+        // skipped (and counted).
+        match tx.try_send(frame) {
+            Ok(()) => {}
+            Err(TrySendError::Full(_)) => {
+                self.in_flight.fetch_sub(1, Ordering::AcqRel);
+                self.skipped += 1;
+            }
+            Err(TrySendError::Disconnected(_)) => self.tx = None,
+        }
+    }
+    /// Flushes what is buffered. For a live viewer, waits at most a few seconds and returns a
+    /// warning if it never answered (a connect to an absent viewer only fails here).
+    pub fn finish(mut self) -> Option<String> {
+        let live = !matches!(self.target, RerunTarget::Save(_));
+        // Rerun's own shutdown waits for its sink without a limit; a live viewer that stopped
+        // taking data would hold the program forever. So the stream is let go of (not shut
+        // down) when a live viewer does not answer in time: the process ends without it.
+        let wait = if live {
+            Duration::from_secs(5)
+        } else {
+            Duration::from_secs(600)
+        };
+        // The logging thread ends when it has drawn every step sent.
+        self.tx = None;
+        if let (Some(thread), Some(done)) = (self.thread.take(), self.done.take()) {
+            match done.recv_timeout(wait) {
+                Ok(()) | Err(RecvTimeoutError::Disconnected) => {
+                    if thread.join().is_err() {
+                        return Some(
+                            "the Rerun logging thread failed; the viewer's data stops early".into(),
+                        );
+                    }
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    let message = self.stalled("the viewer stopped taking data");
+                    std::mem::forget(self.rec);
+                    return Some(message);
+                }
+            }
+        }
+        match self.rec.flush_with_timeout(wait) {
+            Ok(()) => None,
+            Err(e) => {
+                let message = self.stalled(&e.to_string());
+                if live {
+                    std::mem::forget(self.rec);
+                }
+                Some(message)
+            }
+        }
+    }
+
+    fn stalled(&self, why: &str) -> String {
+        match &self.target {
+            RerunTarget::Save(p) => {
+                format!("the Rerun file {} may be incomplete: {why}", p.display())
+            }
+            _ => format!(
+                "no Rerun viewer took all the data ({why}); start one with `rerun` (pip install \
+                 rerun-sdk==0.36.3) and try again"
+            ),
+        }
+    }
+}
+
+/// One step, as the logging thread needs it: taken on the simulation thread, so it holds only
+/// what the viewer shows, in f32 (what Rerun draws with).
+struct Frame {
+    dim: usize,
+    step: u64,
+    time: f64,
+    step_ms: f64,
+    /// Kind names and colours, by kind id.
+    kinds: Vec<(String, [u8; 3])>,
+    /// The live critters that are not walls, in slot order.
+    kind: Vec<u32>,
+    id: Vec<CritterId>,
+    health: Vec<f64>,
+    radius: Vec<f32>,
+    pos: Vec<[f32; 3]>,
+    vel: Vec<[f32; 3]>,
+    /// Contact points and impulses (normal times impulse).
+    contacts: Vec<([f32; 3], [f32; 3])>,
+    spawns: Vec<CritterId>,
+    deaths: Vec<CritterId>,
+    log: Vec<String>,
+    kinetic_energy: f64,
+    momentum: [f64; 3],
+    collisions: u64,
+}
+
+impl Frame {
+    fn empty() -> Frame {
+        Frame {
+            dim: 2,
+            step: 0,
+            time: 0.0,
+            step_ms: 0.0,
+            kinds: Vec::new(),
+            kind: Vec::new(),
+            id: Vec::new(),
+            health: Vec::new(),
+            radius: Vec::new(),
+            pos: Vec::new(),
+            vel: Vec::new(),
+            contacts: Vec::new(),
+            spawns: Vec::new(),
+            deaths: Vec::new(),
+            log: Vec::new(),
+            kinetic_energy: 0.0,
+            momentum: [0.0; 3],
+            collisions: 0,
+        }
+    }
+
+    /// Fills this frame (a recycled one: its buffers are reused) with the step just taken.
+    fn fill<V: Vector>(&mut self, w: &World<V>, step_time: Duration) {
+        let f = self;
+        f.dim = V::DIM;
+        f.step = w.step_count();
+        f.time = w.time();
+        f.step_ms = step_time.as_secs_f64() * 1e3;
+        if f.kinds.len() != w.kinds().len() {
+            f.kinds = w
+                .kinds()
+                .iter()
+                .map(|(id, k)| {
+                    let i = id.0 as usize;
+                    (k.name.clone(), color_of(k.defaults.color.as_deref(), i))
+                })
+                .collect();
+        }
+        let n = w.critters().len();
+        f.kind.clear();
+        f.kind.reserve(n);
+        f.id.clear();
+        f.id.reserve(n);
+        f.health.clear();
+        f.health.reserve(n);
+        f.radius.clear();
+        f.radius.reserve(n);
+        f.pos.clear();
+        f.pos.reserve(n);
+        f.vel.clear();
+        f.vel.reserve(n);
+        // The same sums, in the same order, as World::kinetic_energy and World::momentum.
+        let mut energy = 0.0;
+        let mut momentum = V::zero();
+        for c in w.critters().iter() {
+            energy += c.kinetic_energy();
+            if !c.is_fixed() {
+                momentum += c.vel * c.mass();
+            }
+            if !c.is_alive() || c.is_wall() {
+                continue;
+            }
+            f.kind.push(c.kind().0);
+            f.id.push(c.id());
+            f.health.push(c.health);
+            f.radius.push(c.radius() as f32);
+            f.pos.push(f32x3(c.pos));
+            f.vel.push(f32x3(c.vel));
+        }
+        f.kinetic_energy = energy;
+        f.momentum = momentum.to_array3();
+        f.collisions = w.stats().collisions as u64;
+        let events = w.events();
+        f.contacts.clear();
+        f.contacts.extend(
+            events
+                .collisions
+                .iter()
+                .map(|e| (f32x3(e.point), f32x3(e.normal * e.impulse))),
+        );
+        f.spawns.clone_from(&events.spawns);
+        f.deaths.clone_from(&events.deaths);
+        f.log.clone_from(&events.log);
+    }
+}
+
+/// What was last logged in full for a kind: the critters (ids, health bits, radius bits). While
+/// they stay the same, a step logs only positions and velocities; labels, radii and colours
+/// carry over in the viewer.
+#[derive(PartialEq)]
+struct Logged {
+    id: Vec<CritterId>,
+    health: Vec<u64>,
+    radius: Vec<u32>,
+}
+
+/// The logging thread's side: builds Rerun's archetypes from frames, in step order.
+struct Drawer {
+    rec: RecordingStream,
+    arrows: bool,
+    labels: bool,
+    /// Kinds seen so far, with what was last logged in full for each (`None` after a clear).
+    kinds: BTreeMap<String, Option<Logged>>,
+}
+
+fn xy(p: [f32; 3]) -> [f32; 2] {
+    [p[0], p[1]]
+}
+
+impl Drawer {
+    fn draw(&mut self, f: &Frame) {
+        let rec = &self.rec;
+        rec.set_time_sequence("step", f.step as i64);
+        rec.set_duration_secs("sim_time", f.time);
+        let name_of = |k: usize| f.kinds.get(k).map_or("?", |(n, _)| n.as_str());
+        // Group critters by kind, in slot order.
+        let mut members_of: Vec<Vec<usize>> = vec![Vec::new(); f.kinds.len()];
+        for (i, &k) in f.kind.iter().enumerate() {
+            if let Some(m) = members_of.get_mut(k as usize) {
+                m.push(i);
+            }
+        }
+        let by_kind: BTreeMap<&str, Vec<usize>> = members_of
+            .into_iter()
+            .enumerate()
+            .filter(|(_, m)| !m.is_empty())
+            .map(|(k, m)| (name_of(k), m))
+            .collect();
         // Kinds that have died out are cleared, so they do not linger.
-        for name in self.kinds_seen.keys() {
-            if !by_kind.contains_key(name) {
+        for (name, logged) in self.kinds.iter_mut() {
+            if !by_kind.contains_key(name.as_str()) && logged.is_some() {
                 let _ = rec.log(format!("world/critters/{name}"), &rerun::Clear::flat());
                 let _ = rec.log(format!("world/velocities/{name}"), &rerun::Clear::flat());
+                *logged = None;
             }
         }
         for (name, members) in &by_kind {
-            self.kinds_seen.insert(name.clone(), ());
-            let kind_id = critters[members[0]].kind();
-            let color = color_of(
-                kinds.get(kind_id).defaults.color.as_deref(),
-                kind_id.0 as usize,
-            );
-            let radii: Vec<f32> = members
-                .iter()
-                .map(|&i| critters[i].radius() as f32)
-                .collect();
-            let labels: Vec<String> = if self.labels {
+            let kind = f.kind[members[0]];
+            let color = f.kinds.get(kind as usize).map_or([128; 3], |(_, c)| *c);
+            let now = Logged {
+                id: members.iter().map(|&i| f.id[i]).collect(),
+                health: members.iter().map(|&i| f.health[i].to_bits()).collect(),
+                radius: members.iter().map(|&i| f.radius[i].to_bits()).collect(),
+            };
+            let slot = self.kinds.entry(name.to_string()).or_insert(None);
+            let full = slot.as_ref() != Some(&now);
+            let path = format!("world/critters/{name}");
+            let radii = || members.iter().map(|&i| f.radius[i]).collect::<Vec<f32>>();
+            let labels = || {
                 members
                     .iter()
-                    .map(|&i| format!("{} {} hp {}", critters[i].id(), name, critters[i].health))
-                    .collect()
-            } else {
-                Vec::new()
+                    .map(|&i| format!("{} {} hp {}", f.id[i], name, f.health[i]))
+                    .collect::<Vec<String>>()
             };
-            let path = format!("world/critters/{name}");
-            if V::DIM == 2 {
-                let pos: Vec<[f32; 2]> = members.iter().map(|&i| f32x2(critters[i].pos)).collect();
-                let mut points = rerun::Points2D::new(pos.clone())
-                    .with_radii(radii)
-                    .with_colors([color]);
-                if self.labels {
-                    points = points.with_labels(labels);
+            if f.dim == 2 {
+                let pos: Vec<[f32; 2]> = members.iter().map(|&i| xy(f.pos[i])).collect();
+                let mut points = if full {
+                    rerun::Points2D::new(pos.clone())
+                        .with_radii(radii())
+                        .with_colors([color])
+                } else {
+                    rerun::Points2D::update_fields().with_positions(pos.clone())
+                };
+                if full && self.labels {
+                    points = points.with_labels(labels());
                 }
                 let _ = rec.log(path, &points);
                 if self.arrows {
-                    let vel: Vec<[f32; 2]> =
-                        members.iter().map(|&i| f32x2(critters[i].vel)).collect();
+                    let vel: Vec<[f32; 2]> = members.iter().map(|&i| xy(f.vel[i])).collect();
                     let _ = rec.log(
                         format!("world/velocities/{name}"),
                         &rerun::Arrows2D::from_vectors(vel)
@@ -269,16 +566,19 @@ impl RerunSink {
                     );
                 }
             } else {
-                let pos: Vec<[f32; 3]> = members.iter().map(|&i| f32x3(critters[i].pos)).collect();
-                let mut spheres = rerun::Ellipsoids3D::from_centers_and_radii(pos.clone(), radii)
-                    .with_colors([color]);
-                if self.labels {
-                    spheres = spheres.with_labels(labels);
+                let pos: Vec<[f32; 3]> = members.iter().map(|&i| f.pos[i]).collect();
+                let mut spheres = if full {
+                    rerun::Ellipsoids3D::from_centers_and_radii(pos.clone(), radii())
+                        .with_colors([color])
+                } else {
+                    rerun::Ellipsoids3D::update_fields().with_centers(pos.clone())
+                };
+                if full && self.labels {
+                    spheres = spheres.with_labels(labels());
                 }
                 let _ = rec.log(path, &spheres);
                 if self.arrows {
-                    let vel: Vec<[f32; 3]> =
-                        members.iter().map(|&i| f32x3(critters[i].vel)).collect();
+                    let vel: Vec<[f32; 3]> = members.iter().map(|&i| f.vel[i]).collect();
                     let _ = rec.log(
                         format!("world/velocities/{name}"),
                         &rerun::Arrows3D::from_vectors(vel)
@@ -287,19 +587,17 @@ impl RerunSink {
                     );
                 }
             }
+            if full {
+                *slot = Some(now);
+            }
         }
 
         // Contacts: shown on the step they happen only.
-        let events = w.events();
-        if events.collisions.is_empty() {
+        if f.contacts.is_empty() {
             let _ = rec.log("world/contacts", &rerun::Clear::flat());
-        } else if V::DIM == 2 {
-            let points: Vec<[f32; 2]> = events.collisions.iter().map(|e| f32x2(e.point)).collect();
-            let impulses: Vec<[f32; 2]> = events
-                .collisions
-                .iter()
-                .map(|e| f32x2(e.normal * e.impulse))
-                .collect();
+        } else if f.dim == 2 {
+            let points: Vec<[f32; 2]> = f.contacts.iter().map(|c| xy(c.0)).collect();
+            let impulses: Vec<[f32; 2]> = f.contacts.iter().map(|c| xy(c.1)).collect();
             let _ = rec.log(
                 "world/contacts",
                 &rerun::Arrows2D::from_vectors(impulses)
@@ -307,12 +605,8 @@ impl RerunSink {
                     .with_colors([[230, 60, 60]]),
             );
         } else {
-            let points: Vec<[f32; 3]> = events.collisions.iter().map(|e| f32x3(e.point)).collect();
-            let impulses: Vec<[f32; 3]> = events
-                .collisions
-                .iter()
-                .map(|e| f32x3(e.normal * e.impulse))
-                .collect();
+            let points: Vec<[f32; 3]> = f.contacts.iter().map(|c| c.0).collect();
+            let impulses: Vec<[f32; 3]> = f.contacts.iter().map(|c| c.1).collect();
             let _ = rec.log(
                 "world/contacts",
                 &rerun::Arrows3D::from_vectors(impulses)
@@ -320,20 +614,19 @@ impl RerunSink {
                     .with_colors([[230, 60, 60]]),
             );
         }
-        let describe = |id: CritterId| format!("critter {id}");
-        for id in &events.spawns {
+        for id in &f.spawns {
             let _ = rec.log(
                 "log",
-                &rerun::TextLog::new(format!("spawned {}", describe(*id))).with_level("INFO"),
+                &rerun::TextLog::new(format!("spawned critter {id}")).with_level("INFO"),
             );
         }
-        for id in &events.deaths {
+        for id in &f.deaths {
             let _ = rec.log(
                 "log",
-                &rerun::TextLog::new(format!("{} died", describe(*id))).with_level("WARN"),
+                &rerun::TextLog::new(format!("critter {id} died")).with_level("WARN"),
             );
         }
-        for line in &events.log {
+        for line in &f.log {
             let _ = rec.log(
                 "log",
                 &rerun::TextLog::new(line.clone()).with_level("DEBUG"),
@@ -341,42 +634,20 @@ impl RerunSink {
         }
 
         // Totals.
-        let p = w.momentum().to_array3();
         let _ = rec.log(
             "stats/kinetic_energy",
-            &rerun::Scalars::single(w.kinetic_energy()),
+            &rerun::Scalars::single(f.kinetic_energy),
         );
-        for (axis, name) in ["x", "y", "z"].iter().enumerate().take(V::DIM) {
+        for (axis, name) in ["x", "y", "z"].iter().enumerate().take(f.dim) {
             let _ = rec.log(
                 format!("stats/momentum/{name}"),
-                &rerun::Scalars::single(p[axis]),
+                &rerun::Scalars::single(f.momentum[axis]),
             );
         }
         let _ = rec.log(
             "stats/collisions",
-            &rerun::Scalars::single(w.stats().collisions as f64),
+            &rerun::Scalars::single(f.collisions as f64),
         );
-        let _ = rec.log(
-            "stats/step_ms",
-            &rerun::Scalars::single(step_time.as_secs_f64() * 1e3),
-        );
-    }
-
-    /// Flushes what is buffered. For a live viewer, waits at most a few seconds and returns a
-    /// warning if it never answered (a connect to an absent viewer only fails here).
-    pub fn finish(self) -> Option<String> {
-        let wait = match self.target {
-            RerunTarget::Save(_) => Duration::from_secs(600),
-            _ => Duration::from_secs(5),
-        };
-        match self.rec.flush_with_timeout(wait) {
-            Ok(()) => None,
-            Err(e) => Some(match &self.target {
-                RerunTarget::Save(p) => format!("the Rerun file {} may be incomplete: {e}", p.display()),
-                _ => format!(
-                    "no Rerun viewer took the data ({e}); start one with `rerun` (pip install rerun-sdk==0.36.3) and try again"
-                ),
-            }),
-        }
+        let _ = rec.log("stats/step_ms", &rerun::Scalars::single(f.step_ms));
     }
 }

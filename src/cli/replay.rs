@@ -1,14 +1,17 @@
 //! `critterbox replay FILE`: a recording played back headless: a summary and per-step totals,
 //! the exact state of any step (`--step N`), or a check that re-simulating from the file alone
-//! gives every recorded step bit for bit (`--verify`).
+//! gives every recorded step bit for bit (`--verify`); with `--rerun`, `--rerun-connect` or
+//! `--rerun-save`, the run is re-simulated from the file and sent to the Rerun viewer step by
+//! step, each step's hash checked against the recording on the way.
 
-use crate::recording::replay::{state_at_step, StateSource};
+use crate::recording::replay::{state_at_step, Replay, StateSource};
 use crate::recording::schema::{id_of, StateMsg};
 use crate::recording::verify::verify;
 use crate::recording::{Recording, SceneSource};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
+use std::time::Instant;
 
 /// Arguments of `critterbox replay`.
 #[derive(Args, Debug)]
@@ -28,6 +31,9 @@ pub struct ReplayArgs {
     /// Rows of the per-step totals table.
     #[arg(long, default_value_t = 12)]
     pub rows: usize,
+    /// Watching the recorded run (re-simulated from the file; every step's hash is checked).
+    #[command(flatten)]
+    pub view: super::view::ViewArgs,
 }
 
 /// Runs the command.
@@ -53,6 +59,9 @@ pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         return warn_truncated(&rec, out);
     }
     summary(&rec, out, args.rows)?;
+    if args.view.wanted() {
+        to_viewer(&rec, &args.view, out)?;
+    }
     if args.verify {
         let report = verify(&rec, |_| {})?;
         match &report.mismatch {
@@ -85,6 +94,70 @@ pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         }
     }
     warn_truncated(&rec, out)
+}
+
+/// Re-simulates the recorded run from the file and sends every step to the viewer. Stops at the
+/// first step whose hash differs from the recording, so the viewer never shows a run that was
+/// not the one recorded.
+fn to_viewer(
+    rec: &Recording,
+    view: &super::view::ViewArgs,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let mut replay = Replay::new(rec)?;
+    let mut viewer = super::view::Viewer::open(view, replay.world())?;
+    let last = rec.last_step();
+    let bar = super::run::progress_bar(last);
+    let mut diverged: Option<(u64, u64, u64)> = None;
+    let mut since = Instant::now();
+    let reached = replay.step_to(last, |world| {
+        let step = world.step_count();
+        if let Some(&recorded) = rec.hashes.get(&step) {
+            let got = world.state_hash();
+            if got != recorded {
+                diverged = Some((step, recorded, got));
+                anyhow::bail!("diverged");
+            }
+        }
+        viewer.step(world, since.elapsed());
+        if step % 16 == 0 {
+            bar.set_position(step);
+        }
+        since = Instant::now();
+        Ok(())
+    });
+    bar.finish_and_clear();
+    let shown = replay.step_count() - u64::from(diverged.is_some());
+    let spent = viewer.finish();
+    writeln!(
+        out,
+        "viewer       steps 0 to {shown} re-simulated from the recording and sent to Rerun{}",
+        spent.map_or(String::new(), |(d, skipped)| format!(
+            " ({:.3} s logging{})",
+            d.as_secs_f64(),
+            if skipped > 0 {
+                format!("; {skipped} steps not shown: the viewer fell behind")
+            } else {
+                String::new()
+            }
+        ))
+    )?;
+    if let Some((step, recorded, got)) = diverged {
+        anyhow::bail!(
+            "{}: the replay departs from the recording at step {step} (hash {got:016x}, recorded \
+             {recorded:016x}); the viewer shows steps 0 to {shown} only. `critterbox replay \
+             --verify` names the first critter that differs",
+            rec.path.display()
+        );
+    }
+    if let Err(e) = reached {
+        anyhow::bail!(
+            "{}: the replay stopped at step {} of {last}: {e:#}",
+            rec.path.display(),
+            replay.step_count()
+        );
+    }
+    Ok(())
 }
 
 fn warn_truncated(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> {

@@ -147,12 +147,17 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let viewing = viewer.finish();
     let done = scene.world.step_count();
     summary(out, &name, &scene.world, done, energy0, momentum0, wall)?;
-    if let Some(spent) = viewing {
+    if let Some((spent, skipped)) = viewing {
         writeln!(
             out,
-            "viewer       {:.3} s logging to Rerun ({:.1}% of the run)",
+            "viewer       {:.3} s of the simulation thread spent on Rerun ({:.1}% of the run){}",
             spent.as_secs_f64(),
-            100.0 * spent.as_secs_f64() / wall.as_secs_f64().max(1e-9)
+            100.0 * spent.as_secs_f64() / wall.as_secs_f64().max(1e-9),
+            if skipped > 0 {
+                format!("; {skipped} steps not shown (the viewer fell behind)")
+            } else {
+                String::new()
+            }
         )?;
     }
     let method = scene.world.method();
@@ -237,7 +242,7 @@ fn parse_method(s: &str) -> Result<crate::method::Method, String> {
     s.parse()
 }
 
-fn progress_bar(steps: u64) -> ProgressBar {
+pub(crate) fn progress_bar(steps: u64) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr_with_hz(10));
     bar.set_style(
         ProgressStyle::with_template("{spinner} step {pos}/{len} [{bar:30}] {per_sec} eta {eta}")

@@ -24,7 +24,8 @@ pub struct ViewArgs {
 }
 
 impl ViewArgs {
-    fn wanted(&self) -> bool {
+    /// True when any viewer output was asked for.
+    pub fn wanted(&self) -> bool {
         self.rerun || self.rerun_connect.is_some() || self.rerun_save.is_some()
     }
 }
@@ -91,12 +92,12 @@ impl Viewer {
         let _ = (world, step_time);
     }
 
-    /// Finishes; returns the time spent logging, and prints a warning if a live viewer never
-    /// took the data.
-    pub fn finish(self) -> Option<Duration> {
+    /// Finishes; returns the time taken from the simulation thread and the steps a live
+    /// viewer skipped, and prints a warning if a live viewer never took the data.
+    pub fn finish(self) -> Option<(Duration, u64)> {
         #[cfg(feature = "rerun")]
         if let Some(sink) = self.sink {
-            let spent = sink.logging_time();
+            let spent = (sink.logging_time(), sink.skipped());
             if let Some(warning) = sink.finish() {
                 eprintln!("warning: {warning}");
             }
