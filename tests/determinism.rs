@@ -234,3 +234,70 @@ fn separation_across_the_periodic_edge_keeps_positions_in_the_box() {
         );
     }
 }
+
+/// A world of more than `HASH_CHUNK` slots is hashed in chunks, in parallel: a one-bit change
+/// to a critter in a later chunk still changes the hash, and undoing it restores it; and the
+/// recorder's totals (summed per chunk) agree with the world's own sums to round-off.
+#[test]
+fn the_chunked_hash_sees_one_bit_anywhere_and_totals_agree() {
+    use critterbox::recording::capture::hash_and_totals;
+    use critterbox::world::HASH_CHUNK;
+    let AnyWorld::D2(mut w) = scenes::build("gas", &params(Some(3 * HASH_CHUNK), 7)).unwrap()
+    else {
+        panic!("the gas is 2D")
+    };
+    assert!(
+        w.critters().slot_count() > 2 * HASH_CHUNK,
+        "test setup: three chunks"
+    );
+    for _ in 0..3 {
+        w.step().unwrap();
+    }
+    let before = w.state_hash();
+    assert_eq!(
+        hash_and_totals(&w).0,
+        before,
+        "the recorder's hash is the world's"
+    );
+    for slot in [5, HASH_CHUNK + 17, 2 * HASH_CHUNK + 1] {
+        let id = w.critters().slot(slot as u32).expect("a critter").id();
+        let c = w.get_mut(id).expect("alive");
+        let vx = c.vel.x;
+        c.vel.x = f64::from_bits(vx.to_bits() ^ 1);
+        assert_ne!(w.state_hash(), before, "a flipped bit in slot {slot}");
+        w.get_mut(id).expect("alive").vel.x = vx;
+        assert_eq!(w.state_hash(), before, "restored in slot {slot}");
+    }
+    let (_, totals) = hash_and_totals(&w);
+    let e = w.kinetic_energy();
+    assert!(
+        (totals.kinetic_energy.0 - e).abs() <= 1e-12 * e,
+        "{} vs {e}",
+        totals.kinetic_energy.0
+    );
+    let p = w.momentum();
+    let scale = w
+        .critters()
+        .iter()
+        .filter(|c| !c.is_fixed())
+        .map(|c| c.vel.length() * c.mass())
+        .sum::<f64>();
+    for (a, got) in [p.x, p.y].iter().zip(&totals.momentum.0) {
+        assert!((a - got).abs() <= 1e-12 * scale, "{a} vs {got}");
+    }
+}
+
+/// Up to `HASH_CHUNK` slots the recorder's totals are the world's own sums, bit for bit.
+#[test]
+fn small_worlds_record_the_worlds_own_sums() {
+    use critterbox::recording::capture::hash_and_totals;
+    let AnyWorld::D2(mut w) = scenes::build("gas", &params(Some(1000), 3)).unwrap() else {
+        panic!("the gas is 2D")
+    };
+    w.step().unwrap();
+    let (_, t) = hash_and_totals(&w);
+    assert_eq!(t.kinetic_energy.0.to_bits(), w.kinetic_energy().to_bits());
+    let p = w.momentum();
+    assert_eq!(t.momentum.0[0].to_bits(), p.x.to_bits());
+    assert_eq!(t.momentum.0[1].to_bits(), p.y.to_bits());
+}
