@@ -148,11 +148,6 @@ impl<V: Vector> CritterSet<V> {
         self.slots.par_iter()
     }
 
-    /// The slots (a free one is `None`), in order.
-    pub fn slots(&self) -> &[Option<Critter<V>>] {
-        &self.slots
-    }
-
     /// The critters, in slot order, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.slots.iter_mut().filter_map(Option::as_mut)

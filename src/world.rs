@@ -39,9 +39,6 @@ use std::time::{Duration, Instant};
 /// results do not depend on the number of threads).
 pub const PARALLEL_MIN: usize = 20_000;
 
-/// Slots per chunk of [`World::state_hash`]: worlds with more are hashed in parallel chunks.
-pub const HASH_CHUNK: usize = 4096;
-
 /// The settings a world is made with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorldConfig<V: Vector> {
@@ -430,65 +427,43 @@ impl<V: Vector> World<V> {
     /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
     /// radius, mass, priority, restitution, health and properties.
     pub fn state_hash(&self) -> u64 {
-        self.state_hash_chunked(|_: &mut (), _| {}).0
+        self.state_hash_visiting(|_| {})
     }
 
-    /// [`World::state_hash`], calling `visit` on each critter in the same pass, so a recorder can
-    /// sum its totals without walking the critters a second time. The slots are taken in chunks
-    /// of [`HASH_CHUNK`] (in parallel when there is more than one); each chunk's critters are
-    /// visited in slot order with the chunk's own accumulator, and the accumulators come back in
-    /// chunk order. The hash does not depend on the number of threads: chunk 0 continues the
-    /// header's hasher, every later chunk `k` gets a fresh one seeded with `k`, and their results
-    /// are folded in, in order. A world of up to `HASH_CHUNK` slots hashes as one sequence.
-    pub fn state_hash_chunked<A: Default + Send>(
-        &self,
-        visit: impl Fn(&mut A, &Critter<V>) + Sync,
-    ) -> (u64, Vec<A>) {
-        let mut head = StateHasher::default();
-        head.word(self.step_count);
-        head.float(self.dt);
+    /// [`World::state_hash`], calling `visit` on each critter (in slot order) in the same pass,
+    /// so a recorder can sum its totals without walking the critters a second time.
+    pub fn state_hash_visiting(&self, mut visit: impl FnMut(&Critter<V>)) -> u64 {
+        let mut h = StateHasher::default();
+        h.word(self.step_count);
+        h.float(self.dt);
         for w in self.rng.state() {
-            head.word(w);
+            h.word(w);
         }
-        let hash_chunk = |k: usize, chunk: &[Option<Critter<V>>]| {
-            let mut h = if k == 0 {
-                head.clone()
+        for c in self.critters.iter() {
+            visit(c);
+            let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
+            let flags = ((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64;
+            let (z, vz) = if V::DIM == 3 {
+                (c.pos.get(2), c.vel.get(2))
             } else {
-                let mut h = StateHasher::default();
-                h.word(k as u64);
-                h
+                (0.0, 0.0)
             };
-            let mut acc = A::default();
-            for c in chunk.iter().flatten() {
-                visit(&mut acc, c);
-                hash_critter(&mut h, c);
+            h.words([
+                id,
+                flags ^ (c.props.len() as u64).rotate_left(40),
+                pair(c.pos.get(0), c.pos.get(1)),
+                pair(c.vel.get(0), c.vel.get(1)),
+                pair(c.radius, c.mass),
+                pair(c.priority, c.restitution),
+                pair(c.health, z),
+                vz.to_bits(),
+            ]);
+            for (name, value) in &c.props {
+                hash_bytes(&mut h, name.as_bytes());
+                hash_prop(&mut h, value);
             }
-            (h, acc)
-        };
-        let chunks: Vec<(StateHasher, A)> = if self.critters.slot_count() > HASH_CHUNK {
-            use rayon::prelude::*;
-            self.critters
-                .slots()
-                .par_chunks(HASH_CHUNK)
-                .enumerate()
-                .map(|(k, chunk)| hash_chunk(k, chunk))
-                .collect()
-        } else {
-            vec![hash_chunk(0, self.critters.slots())]
-        };
-        let mut accs = Vec::with_capacity(chunks.len());
-        let mut h = None;
-        for (k, (hk, acc)) in chunks.into_iter().enumerate() {
-            match &mut h {
-                None => h = Some(hk),
-                Some(h0) => {
-                    debug_assert!(k > 0);
-                    h0.word(hk.finish());
-                }
-            }
-            accs.push(acc);
         }
-        (h.unwrap_or(head).finish(), accs)
+        h.finish()
     }
 
     // ----- building ---------------------------------------------------------------------------
@@ -1146,33 +1121,6 @@ fn hook_error<V: Vector>(
             step,
             message: other.to_string(),
         },
-    }
-}
-
-/// One critter's words: id, kind, flags, position, velocity, radius, mass, priority,
-/// restitution, health and properties.
-#[inline]
-fn hash_critter<V: Vector>(h: &mut StateHasher, c: &Critter<V>) {
-    let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
-    let flags = ((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64;
-    let (z, vz) = if V::DIM == 3 {
-        (c.pos.get(2), c.vel.get(2))
-    } else {
-        (0.0, 0.0)
-    };
-    h.words([
-        id,
-        flags ^ (c.props.len() as u64).rotate_left(40),
-        pair(c.pos.get(0), c.pos.get(1)),
-        pair(c.vel.get(0), c.vel.get(1)),
-        pair(c.radius, c.mass),
-        pair(c.priority, c.restitution),
-        pair(c.health, z),
-        vz.to_bits(),
-    ]);
-    for (name, value) in &c.props {
-        hash_bytes(h, name.as_bytes());
-        hash_prop(h, value);
     }
 }
 

@@ -57,23 +57,17 @@ pub fn kind_table<V: Vector>(world: &World<V>) -> KindTable {
     t
 }
 
-/// Hash and totals in one pass over the critters (in parallel chunks for large worlds: see
-/// [`World::state_hash_chunked`]). Energy and momentum are summed in slot order within each
-/// chunk, and the chunks' sums in chunk order, so the totals do not depend on the number of
-/// threads either; up to [`crate::world::HASH_CHUNK`] slots they are the very sums of
-/// `World::kinetic_energy` and `World::momentum`.
+/// Hash and totals in one pass over the critters.
 pub fn hash_and_totals<V: Vector>(world: &World<V>) -> (u64, TotalsMsg) {
-    let (hash, sums) = world.state_hash_chunked(|acc: &mut (f64, V), c| {
-        acc.0 += c.kinetic_energy();
+    let mut energy = 0.0;
+    let mut momentum = V::zero();
+    let hash = world.state_hash_visiting(|c| {
+        // The same sums, in the same order, as World::kinetic_energy and World::momentum.
+        energy += c.kinetic_energy();
         if !c.is_fixed() {
-            acc.1 += c.vel * c.mass();
+            momentum += c.vel * c.mass();
         }
     });
-    let (mut energy, mut momentum) = (0.0, V::zero());
-    for (e, p) in sums {
-        energy += e;
-        momentum += p;
-    }
     let stats = world.stats();
     let totals = TotalsMsg {
         step: world.step_count(),
