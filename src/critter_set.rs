@@ -148,6 +148,51 @@ impl<V: Vector> CritterSet<V> {
         self.slots.par_iter()
     }
 
+    /// The free slots, in the order they are kept (the last is reused first), as the ids their
+    /// next critters will get.
+    pub fn free_ids(&self) -> impl Iterator<Item = CritterId> + '_ {
+        self.free.iter().map(|&index| CritterId {
+            index,
+            generation: self.generations[index as usize],
+        })
+    }
+
+    /// A set rebuilt from its parts: the critters by slot (their ids give the slots'
+    /// generations) and the free list as the ids their next critters get. Slots that are
+    /// neither are retired. `None` if the parts contradict each other.
+    pub(crate) fn from_parts(critters: Vec<Critter<V>>, free: &[CritterId]) -> Option<Self> {
+        let slots_needed = critters
+            .iter()
+            .map(|c| c.id.index)
+            .chain(free.iter().map(|id| id.index))
+            .max()
+            .map_or(0, |m| m as usize + 1);
+        let mut set = CritterSet {
+            slots: (0..slots_needed).map(|_| None).collect(),
+            generations: vec![u32::MAX; slots_needed],
+            free: Vec::with_capacity(free.len()),
+            live: 0,
+        };
+        for c in critters {
+            let i = c.id.index as usize;
+            if set.slots[i].is_some() {
+                return None;
+            }
+            set.generations[i] = c.id.generation;
+            set.slots[i] = Some(c);
+            set.live += 1;
+        }
+        for id in free {
+            let i = id.index as usize;
+            if set.slots[i].is_some() || set.generations[i] != u32::MAX {
+                return None;
+            }
+            set.generations[i] = id.generation;
+            set.free.push(id.index);
+        }
+        Some(set)
+    }
+
     /// The critters, in slot order, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.slots.iter_mut().filter_map(Option::as_mut)

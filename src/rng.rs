@@ -58,6 +58,11 @@ impl Rng {
     pub fn state(&self) -> [u64; 4] {
         self.s
     }
+
+    /// A generator at a state [`Rng::state`] returned.
+    pub fn from_state(s: [u64; 4]) -> Rng {
+        Rng { s }
+    }
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@ use crate::critter::{
 };
 use crate::critter_set::CritterSet;
 use crate::error::Error;
-use crate::hash::{pair, StateHasher};
+use crate::hash::{quad, StateHasher};
 use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
 use crate::method::Method;
 use crate::rng::Rng;
@@ -344,6 +344,56 @@ impl<V: Vector> World<V> {
     pub fn time(&self) -> f64 {
         self.step_count as f64 * self.dt
     }
+    /// The random generator's state (what [`World::state_hash`] covers of it).
+    pub fn rng_state(&self) -> [u64; 4] {
+        self.rng.state()
+    }
+
+    /// Puts the world in a recorded state between steps: `step` steps taken, the generator at
+    /// `rng`, and these critters and free slots (see [`CritterSet::from_parts`]). Walls are
+    /// taken from this world, by id: a state whose walls this world does not have is refused.
+    /// Caches (broad phase, rule classes, method scratch) start afresh; the result is the
+    /// recorded world exactly when its [`World::state_hash`] equals the recorded one.
+    pub(crate) fn restore(
+        &mut self,
+        step: u64,
+        rng: [u64; 4],
+        critters: Vec<Critter<V>>,
+        free: &[CritterId],
+    ) -> Result<(), String> {
+        let mut all = Vec::with_capacity(critters.len() + self.walls.len());
+        let mut walls = Vec::new();
+        for c in critters {
+            if c.kind == WALL {
+                let Some(wall) = self.critters.get(c.id) else {
+                    return Err(format!(
+                        "the state has wall {} and this world does not",
+                        c.id
+                    ));
+                };
+                walls.push(c.id);
+                all.push(wall.clone());
+            } else {
+                all.push(c);
+            }
+        }
+        // The walls keep this world's order (the order their pairs are tested in).
+        let mut kept: Vec<CritterId> = self.walls.clone();
+        kept.retain(|w| walls.contains(w));
+        let set = CritterSet::from_parts(all, free)
+            .ok_or_else(|| "the state's slots contradict each other".to_string())?;
+        self.critters = set;
+        self.walls = kept;
+        self.rng = Rng::from_state(rng);
+        self.step_count = step;
+        self.broad = BroadPhase::new(self.broad.mode);
+        self.pending = Pending::default();
+        self.events.clear();
+        self.auto_choice = None;
+        self.flight = Default::default();
+        Ok(())
+    }
+
     /// The critters.
     pub fn critters(&self) -> &CritterSet<V> {
         &self.critters
@@ -439,30 +489,31 @@ impl<V: Vector> World<V> {
         for w in self.rng.state() {
             h.word(w);
         }
+        // Two words per critter, four critters per eight-lane update, so the lanes' multiplies
+        // overlap and there are few of them (see src/hash.rs). Properties go to a hasher of
+        // their own (after the owner's id), so the main lanes stay in registers.
+        let mut props = StateHasher::default();
+        let mut buf = [0u64; 8];
+        let mut filled = 0;
         for c in self.critters.iter() {
             visit(c);
-            let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
-            let flags = ((c.kind.0 as u64) << 2) | ((c.fixed as u64) << 1) | c.alive as u64;
-            let (z, vz) = if V::DIM == 3 {
-                (c.pos.get(2), c.vel.get(2))
-            } else {
-                (0.0, 0.0)
-            };
-            h.words([
-                id,
-                flags ^ (c.props.len() as u64).rotate_left(40),
-                pair(c.pos.get(0), c.pos.get(1)),
-                pair(c.vel.get(0), c.vel.get(1)),
-                pair(c.radius, c.mass),
-                pair(c.priority, c.restitution),
-                pair(c.health, z),
-                vz.to_bits(),
-            ]);
-            for (name, value) in &c.props {
-                hash_bytes(&mut h, name.as_bytes());
-                hash_prop(&mut h, value);
+            let [a, b] = critter_words(c);
+            buf[filled] = a;
+            buf[filled + 1] = b;
+            filled += 2;
+            if filled == 8 {
+                h.words(buf);
+                filled = 0;
+            }
+            if !c.props.is_empty() {
+                hash_props(&mut props, c);
             }
         }
+        if filled > 0 {
+            buf[filled..].fill(0);
+            h.words(buf);
+        }
+        h.word(props.finish());
         h.finish()
     }
 
@@ -1121,6 +1172,40 @@ fn hook_error<V: Vector>(
             step,
             message: other.to_string(),
         },
+    }
+}
+
+/// A critter's hashed fields in two words. Each word is the XOR of independent fields at
+/// distinct rotations (see [`crate::hash::quad`]), so a change to any one field always changes
+/// its word: id, flags (kind, fixed, alive, number of properties), position and velocity in the
+/// first; radius, mass, priority, restitution, health and the z components (3D) in the second.
+#[inline]
+fn critter_words<V: Vector>(c: &Critter<V>) -> [u64; 2] {
+    let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
+    let flags = ((c.kind.0 as u64) << 2)
+        | ((c.fixed as u64) << 1)
+        | c.alive as u64
+        | ((c.props.len() as u64) << 40);
+    let (z, vz) = if V::DIM == 3 {
+        (c.pos.get(2), c.vel.get(2))
+    } else {
+        (0.0, 0.0)
+    };
+    [
+        id ^ flags.rotate_left(16)
+            ^ quad(c.pos.get(0), c.pos.get(1), c.vel.get(0), c.vel.get(1)).rotate_left(8),
+        quad(c.radius, c.mass, c.priority, c.restitution)
+            ^ quad(c.health, z, vz, 0.0).rotate_left(8),
+    ]
+}
+
+/// A critter's properties (names and values), after its id.
+#[inline(never)]
+fn hash_props<V: Vector>(h: &mut StateHasher, c: &Critter<V>) {
+    h.word(((c.id.index as u64) << 32) | c.id.generation as u64);
+    for (name, value) in &c.props {
+        hash_bytes(h, name.as_bytes());
+        hash_prop(h, value);
     }
 }
 

@@ -195,7 +195,7 @@ fn record_every_k_still_shows_an_unrecorded_step_exactly() {
     );
     assert_eq!(r.hashes.len(), 46, "every step has its hash");
     let (shown, source) = state_at_step(&r, 27).expect("step 27");
-    assert_eq!(source, StateSource::Resimulated { keyframe: Some(20) });
+    assert_eq!(source, StateSource::Restored { keyframe: 20 });
     let truth = state_at(&all, 27)
         .expect("read")
         .expect("every step recorded");
@@ -619,4 +619,136 @@ fn run_records_by_default_under_the_recordings_folder() {
         std::fs::read_dir(dir.join("recordings")).unwrap().count(),
         1
     );
+}
+
+/// A run with deaths: the inspect table's deaths column adds up to the deaths the file records
+/// (the first row, step 0, has none and must not fail).
+#[test]
+fn inspect_counts_the_deaths_of_a_run_with_deaths() {
+    let dir = tmp("inspect_deaths");
+    let file = dir.join("bullets.mcap");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/bullets_vs_player.rhai");
+    record(&file, &[scene.to_str().unwrap(), "--steps", "400"]);
+    let rec = Recording::open(&file).expect("opens");
+    let recorded: usize = rec.lifecycle.iter().map(|l| l.die.len()).sum();
+    assert!(recorded > 0, "test setup: something died");
+    let o = critterbox(&["inspect", file.to_str().unwrap(), "--rows", "100000"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = text(&o);
+    let table: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("over time"))
+        .skip(2)
+        .take_while(|l| l.starts_with("  "))
+        .collect();
+    assert_eq!(table.len(), rec.totals.len(), "one row per step:\n{out}");
+    let shown: usize = table
+        .iter()
+        .map(|l| {
+            l.split_whitespace()
+                .nth(5)
+                .and_then(|d| d.parse::<usize>().ok())
+                .expect("a deaths column")
+        })
+        .sum();
+    assert_eq!(shown, recorded, "{out}");
+}
+
+/// A run with spawns and deaths (slots freed and reused), recorded every 40 steps: any step,
+/// started from the recorded full state before it, equals the same run recorded at every step;
+/// and a file whose states lack the generator (as older versions wrote them) falls back to
+/// re-simulating from step 0, with the reason, and still gives the exact state.
+#[test]
+fn a_step_is_replayed_from_the_keyframe_before_it_exactly() {
+    let dir = tmp("restore");
+    let (all, sparse) = (dir.join("every1.mcap"), dir.join("every40.mcap"));
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/bullets_vs_player.rhai");
+    let scene = scene.to_str().unwrap();
+    record(&all, &[scene, "--record-every", "1"]);
+    record(&sparse, &[scene, "--record-every", "40"]);
+    let r = Recording::open(&sparse).expect("open");
+    let died: usize = r.lifecycle.iter().map(|l| l.die.len()).sum();
+    let spawned: usize = r.lifecycle.iter().map(|l| l.spawn.len()).sum();
+    assert!(died > 0 && spawned > 0, "test setup: spawns and deaths");
+    for step in [1, 39, 41, 99, 130, r.last_step() - 2, r.last_step() - 1] {
+        let (shown, source) = state_at_step(&r, step).expect("a step");
+        let key = r.keyframe_at_or_before(step).expect("a keyframe");
+        let expected = if key == step {
+            StateSource::Recorded
+        } else if key > 0 {
+            StateSource::Restored { keyframe: key }
+        } else {
+            StateSource::Resimulated {
+                keyframe: Some(0),
+                why_not_restored: None,
+            }
+        };
+        assert_eq!(source, expected, "step {step}");
+        let truth = state_at(&all, step)
+            .expect("read")
+            .expect("every step recorded");
+        assert_eq!(
+            first_difference(&truth, &shown, "recorded", "replayed"),
+            None,
+            "step {step}"
+        );
+    }
+
+    // The same file without the generator in its states.
+    let old = dir.join("old.mcap");
+    rewrite(&sparse, &old, |topic, data| {
+        if topic != schema::STATE {
+            return None;
+        }
+        let mut s: StateMsg = serde_json::from_slice(data).expect("state json");
+        s.rng = None;
+        Some(serde_json::to_vec(&s).expect("encode"))
+    })
+    .expect("rewrite");
+    let r = Recording::open(&old).expect("open");
+    let (shown, source) = state_at_step(&r, 130).expect("step 130");
+    match source {
+        StateSource::Resimulated {
+            keyframe: Some(120),
+            why_not_restored: Some(why),
+        } => assert!(why.contains("no generator state"), "{why}"),
+        other => panic!("expected a re-simulation from step 0, got {other:?}"),
+    }
+    let truth = state_at(&all, 130).expect("read").expect("recorded");
+    assert_eq!(
+        first_difference(&truth, &shown, "recorded", "replayed"),
+        None
+    );
+}
+
+/// A restored world that is not the recorded one is never shown: a state whose generator was
+/// changed restores, fails the recorded hash of its step, and the replay starts from step 0.
+#[test]
+fn a_restore_that_does_not_match_the_recorded_hash_is_not_used() {
+    let dir = tmp("restore_bad");
+    let (sparse, bad) = (dir.join("every10.mcap"), dir.join("bad.mcap"));
+    record(
+        &sparse,
+        &["gas", "-n", "60", "--steps", "30", "--record-every", "10"],
+    );
+    rewrite(&sparse, &bad, |topic, data| {
+        if topic != schema::STATE {
+            return None;
+        }
+        let mut s: StateMsg = serde_json::from_slice(data).expect("state json");
+        if let Some(r) = &mut s.rng {
+            r[0] ^= 1;
+        }
+        Some(serde_json::to_vec(&s).expect("encode"))
+    })
+    .expect("rewrite");
+    let r = Recording::open(&bad).expect("open");
+    let (_, source) = state_at_step(&r, 25).expect("step 25");
+    match source {
+        StateSource::Resimulated {
+            why_not_restored: Some(why),
+            ..
+        } => assert!(why.contains("not the recorded one"), "{why}"),
+        other => panic!("expected a re-simulation from step 0, got {other:?}"),
+    }
 }

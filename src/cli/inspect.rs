@@ -98,10 +98,12 @@ pub fn run(args: &InspectArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         let (lo, hi) = (if t.step == 0 { 0 } else { prev }, t.step);
         let coll: u64 = range(lo, hi).map(|x| x.collisions).sum();
         let imp: u64 = range(lo, hi).map(|x| x.impacts).sum();
-        let died: usize = deaths_by_step
-            .range(lo + 1..=hi.max(lo))
-            .map(|(_, n)| n)
-            .sum();
+        // Deaths in steps lo+1..=hi (none for the first row, where lo == hi).
+        let died: usize = if hi > lo {
+            deaths_by_step.range(lo + 1..=hi).map(|(_, n)| n).sum()
+        } else {
+            0
+        };
         let mut line = format!(
             "  {:>8} {:>10.4} {:>8} {:>10} {:>8} {:>7} {:>17.9e}",
             t.step, t.time.0, t.critters, coll, imp, died, t.kinetic_energy.0

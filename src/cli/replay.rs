@@ -46,11 +46,20 @@ pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         } else {
             let how = match source {
                 StateSource::Recorded => "recorded".to_string(),
-                StateSource::Resimulated { keyframe } => format!(
-                    "re-simulated from step 0; every hash matched{}",
+                StateSource::Restored { keyframe } => format!(
+                    "re-simulated from the recorded full state at step {keyframe}; every hash \
+                     matched"
+                ),
+                StateSource::Resimulated {
+                    keyframe,
+                    why_not_restored,
+                } => format!(
+                    "re-simulated from step 0; every hash matched{}{}",
                     keyframe.map_or(String::new(), |k| format!(
                         ", and the full state at step {k}"
-                    ))
+                    )),
+                    why_not_restored
+                        .map_or(String::new(), |w| format!(" (not started from it: {w})"))
                 ),
             };
             writeln!(out, "step {step} (t = {}): {how}", state.time.0)?;

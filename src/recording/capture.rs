@@ -107,6 +107,8 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
         alive: Vec::with_capacity(n),
         props: BTreeMap::new(),
         walls: Vec::new(),
+        rng: Some(world.rng_state().to_vec()),
+        free: Some(world.critters().free_ids().map(id_key).collect()),
     };
     for c in world.critters().iter() {
         let id = id_key(c.id());

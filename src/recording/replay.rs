@@ -1,16 +1,22 @@
 //! Re-simulating a recorded run: the scene rebuilt from the file, stepped as the run was, and
 //! any step's exact state on demand.
 //!
-//! A world cannot be restored from a keyframe without an engine API to set its step count, its
-//! generator and its slot allocation, so a replay runs from step 0; the keyframes it passes are
-//! checked on the way, and the hashes of every step.
+//! To show step N, a replay starts from the nearest recorded full state before N when it can
+//! (the state carries the generator and the free slots, so the world is put back exactly; the
+//! restored world's hash must equal the recorded hash of that step), and from step 0 otherwise.
+//! Every step's hash is checked on the way; if anything differs after a restore (a scene that
+//! keeps state of its own outside the world, say), it starts again from step 0.
 
 use super::capture;
 use super::compare::first_difference;
 use super::reader::{self, Recording};
 use super::rebuild::{rebuild, Rebuilt};
-use super::schema::StateMsg;
+use super::schema::{id_of, StateMsg};
+use crate::critter::{Critter, CritterId, Shape, CLASS_UNSET};
+use crate::kind::KindId;
 use crate::scenes::AnyWorld;
+use crate::vector::Vector;
+use crate::world::World;
 
 /// Why a replay could not reach a step.
 #[derive(Debug, thiserror::Error)]
@@ -88,6 +94,12 @@ impl Replay {
         Ok(())
     }
 
+    /// Puts the world in a recorded full state (see [`restore_any`]).
+    pub fn restore(&mut self, state: &StateMsg) -> Result<(), String> {
+        self.stopped = None;
+        restore_any(&mut self.rebuilt.scene.world, state)
+    }
+
     /// Takes one more step, expecting it to fail (the recording ended with an error); returns the
     /// error, or `None` if the step succeeded.
     pub fn step_expecting_error(&mut self) -> Option<String> {
@@ -106,16 +118,103 @@ impl Replay {
 pub enum StateSource {
     /// Read from the recording.
     Recorded,
+    /// Re-simulated from the recorded full state at step `keyframe` (restored exactly: its hash
+    /// matched), every step's hash matching the recording on the way.
+    Restored {
+        /// The recorded full state the replay started from.
+        keyframe: u64,
+    },
     /// Re-simulated from step 0; every step's hash matched the recording, and the full state
     /// at the keyframe `keyframe` (if any) matched too.
     Resimulated {
         /// The nearest recorded full state before the step.
         keyframe: Option<u64>,
+        /// Why the replay could not start from that state, if it tried.
+        why_not_restored: Option<String>,
     },
 }
 
+/// Puts `world` in the recorded full state `s`: step count, generator, free slots and every
+/// critter (walls are matched by id with the world's own). Fails, changing nothing that
+/// matters, when the state lacks what a restore needs (recordings by older versions have no
+/// generator state) or does not fit this world.
+pub fn restore_any(world: &mut AnyWorld, s: &StateMsg) -> Result<(), String> {
+    match world {
+        AnyWorld::D2(w) => restore_world(w, s),
+        AnyWorld::D3(w) => restore_world(w, s),
+    }
+}
+
+fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String> {
+    s.check()?;
+    let rng: [u64; 4] = s
+        .rng
+        .as_deref()
+        .and_then(|r| r.try_into().ok())
+        .ok_or("the recorded state has no generator state (recorded by an older critterbox)")?;
+    let free: Vec<CritterId> = s
+        .free
+        .as_ref()
+        .ok_or("the recorded state has no free-slot list (recorded by an older critterbox)")?
+        .iter()
+        .map(|&k| id_of(k))
+        .collect();
+    if s.dim() != V::DIM {
+        return Err(format!("a {}D state for a {}D world", s.dim(), V::DIM));
+    }
+    let kinds: Vec<Option<KindId>> = s.kinds.iter().map(|n| w.kinds().id(n).ok()).collect();
+    let mut critters = Vec::with_capacity(s.len());
+    let column = |c: &Option<super::schema::Floats>, i: usize| c.as_ref().map_or(0.0, |c| c.0[i]);
+    for i in 0..s.len() {
+        let kind = kinds
+            .get(s.kind[i] as usize)
+            .copied()
+            .flatten()
+            .ok_or_else(|| format!("kind '{}' is not known yet at step 0", s.kind_name(i)))?;
+        let mut pos = V::zero();
+        let mut vel = V::zero();
+        for (axis, (p, v)) in [
+            (s.x.0[i], s.vx.0[i]),
+            (s.y.0[i], s.vy.0[i]),
+            (column(&s.z, i), column(&s.vz, i)),
+        ]
+        .into_iter()
+        .enumerate()
+        .take(V::DIM)
+        {
+            pos.set(axis, p);
+            vel.set(axis, v);
+        }
+        let id = id_of(s.id[i]);
+        let (mass, fixed) = (s.mass.0[i], s.fixed[i]);
+        critters.push(Critter {
+            id,
+            kind,
+            class: CLASS_UNSET,
+            pos,
+            vel,
+            radius: s.radius.0[i],
+            mass,
+            inv_mass: if fixed { 0.0 } else { 1.0 / mass },
+            priority: s.priority.0[i],
+            restitution: s.restitution.0[i],
+            health: s.health.0[i],
+            fixed,
+            alive: s.alive[i],
+            shape: Shape::Disk,
+            props: s
+                .props
+                .get(&s.id[i].to_string())
+                .cloned()
+                .unwrap_or_default(),
+        });
+    }
+    w.restore(s.step, rng, critters, &free)
+}
+
 /// The exact state after `step` steps: from the file if it holds that state, else re-simulated
-/// and checked against the recorded hashes and the nearest keyframe on the way.
+/// from the nearest recorded full state before it (or from step 0), checked against the
+/// recorded hashes on the way.
 pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, StateSource)> {
     let last = rec.last_step();
     anyhow::ensure!(
@@ -132,17 +231,20 @@ pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, St
         Some(k) => reader::state_at(&rec.path, k)?,
         None => None,
     };
+    // From the keyframe, if the world can be put back in it exactly.
+    let mut why_not = None;
+    if let Some(k) = key_state.as_ref().filter(|k| k.step > 0) {
+        match from_keyframe(rec, k, step) {
+            Ok(state) => {
+                return Ok((state, StateSource::Restored { keyframe: k.step }));
+            }
+            Err(e) => why_not = Some(format!("{e:#}")),
+        }
+    }
     let mut replay = Replay::new(rec)?;
     let check = |world: &AnyWorld| -> anyhow::Result<()> {
         let s = world.step_count();
-        if let Some(&h) = rec.hashes.get(&s) {
-            let got = world.state_hash();
-            anyhow::ensure!(
-                got == h,
-                "the replay diverged from the recording at step {s} (hash {got:016x}, recorded \
-                 {h:016x}); step {step} cannot be shown exactly: run `critterbox replay --verify`"
-            );
-        }
+        check_hash(rec, world, step)?;
         if let Some(k) = &key_state {
             if k.step == s {
                 let mine = capture::any_state(world);
@@ -157,6 +259,40 @@ pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, St
     replay.step_to(step, check)?;
     Ok((
         capture::any_state(replay.world()),
-        StateSource::Resimulated { keyframe },
+        StateSource::Resimulated {
+            keyframe,
+            why_not_restored: why_not,
+        },
     ))
+}
+
+/// The recorded hash of the world's step, if there is one, equals the world's.
+fn check_hash(rec: &Recording, world: &AnyWorld, target: u64) -> anyhow::Result<()> {
+    let s = world.step_count();
+    if let Some(&h) = rec.hashes.get(&s) {
+        let got = world.state_hash();
+        anyhow::ensure!(
+            got == h,
+            "the replay diverged from the recording at step {s} (hash {got:016x}, recorded \
+             {h:016x}); step {target} cannot be shown exactly: run `critterbox replay --verify`"
+        );
+    }
+    Ok(())
+}
+
+/// Step `step`'s state, re-simulated from the recorded full state `key`.
+fn from_keyframe(rec: &Recording, key: &StateMsg, step: u64) -> anyhow::Result<StateMsg> {
+    let mut replay = Replay::new(rec)?;
+    replay
+        .restore(key)
+        .map_err(|e| anyhow::anyhow!("cannot start from the state at step {}: {e}", key.step))?;
+    let at = replay.world().step_count();
+    anyhow::ensure!(
+        rec.hashes.contains_key(&at),
+        "no recorded hash at step {at} to check the restored world against"
+    );
+    check_hash(rec, replay.world(), step)
+        .map_err(|e| anyhow::anyhow!("the restored world is not the recorded one: {e:#}"))?;
+    replay.step_to(step, |w| check_hash(rec, w, step))?;
+    Ok(capture::any_state(replay.world()))
 }

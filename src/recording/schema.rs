@@ -231,6 +231,14 @@ pub struct StateMsg {
     /// Wall boxes.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub walls: Vec<WallMsg>,
+    /// The world's random generator after the step (four 64-bit words), so a replay can start
+    /// from this state instead of from step 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rng: Option<Vec<u64>>,
+    /// The free slots, in the order the world keeps them (the last is reused first), as the ids
+    /// the next critters in them will get.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free: Option<Vec<u64>>,
 }
 
 impl StateMsg {
@@ -512,6 +520,9 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
                 },
                 "required": ["id", "center", "half", "axes"],
             } },
+            "rng": { "type": "array", "items": { "type": "integer", "minimum": 0 },
+                     "description": "the random generator's four 64-bit words after the step" },
+            "free": ids_schema("free slots in the world's order (the last is reused first), as the ids their next critters get"),
         })),
         &[
             "step",
