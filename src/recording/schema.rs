@@ -568,7 +568,6 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
             "kinetic_energy",
             "momentum",
             "critters",
-            "by_kind",
             "collisions",
             "impacts",
             "contacts",
