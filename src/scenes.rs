@@ -139,6 +139,9 @@ pub struct Scene {
     pub on_step: Option<OnStep>,
     /// Script files used (empty for built-in scenes).
     pub sources: Vec<SourceFile>,
+    /// Every script file loaded so far from the `n`-th on, kinds loaded during the run included
+    /// (set for script scenes).
+    pub(crate) loaded_since: Option<Box<dyn Fn(usize) -> Vec<SourceFile>>>,
 }
 
 impl Scene {
@@ -150,6 +153,16 @@ impl Scene {
             default_steps,
             on_step: None,
             sources: Vec::new(),
+            loaded_since: None,
+        }
+    }
+
+    /// The script files loaded so far, from the `n`-th on: `sources` and then any kind the
+    /// scene loaded while running (from `on_step`). Empty for built-in scenes.
+    pub fn sources_since(&self, n: usize) -> Vec<SourceFile> {
+        match &self.loaded_since {
+            Some(f) => f(n),
+            None => self.sources.get(n..).map(<[_]>::to_vec).unwrap_or_default(),
         }
     }
 

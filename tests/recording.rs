@@ -752,3 +752,60 @@ fn a_restore_that_does_not_match_the_recorded_hash_is_not_used() {
         other => panic!("expected a re-simulation from step 0, got {other:?}"),
     }
 }
+
+/// A kind the scene loads while running (from `on_step`) is attached when it is loaded, not at
+/// the end: a run killed later still re-simulates from its recovered file alone, in a folder
+/// where no kind file could be found on disk.
+#[test]
+fn a_kind_loaded_mid_run_survives_a_killed_run() {
+    use std::time::{Duration, Instant};
+    let dir = tmp("late_kind_killed");
+    let file = dir.join("late.mcap");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_critterbox"))
+        .args(["run", "tests/scenes/late_kind.rhai", "--steps", "100000000"])
+        .args(["--record-every", "500", "--record", file.to_str().unwrap()])
+        .current_dir(root)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("spawn");
+    // Until the readable part of the file is well past the step the kind was loaded in.
+    let start = Instant::now();
+    loop {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the run never got far"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+        if Recording::open(&file).is_ok_and(|r| r.last_step() > 2_000) {
+            break;
+        }
+    }
+    let ok = Command::new("kill")
+        .args(["-KILL", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(ok.success());
+    child.wait().expect("wait");
+
+    let o = critterbox(&["recover", file.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let recovered = dir.join("late.recovered.mcap");
+    let r = Recording::open(&recovered).expect("recovered");
+    assert!(
+        r.last_step() > 2_000,
+        "recovered up to step {}",
+        r.last_step()
+    );
+    assert!(
+        r.scripts
+            .iter()
+            .any(|(name, _)| name.ends_with("bullet.rhai")),
+        "the late kind is attached: {:?}",
+        r.scripts.iter().map(|(n, _)| n).collect::<Vec<_>>()
+    );
+    let o = critterbox_in(&dir, &["replay", recovered.to_str().unwrap(), "--verify"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("verify       ok"), "{}", text(&o));
+}

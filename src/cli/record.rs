@@ -5,11 +5,11 @@ use super::run::RunArgs;
 use crate::recording::keyframes::default_record_every;
 use crate::recording::meta::utc_now;
 use crate::recording::{path, EndMeta, Recorder, RunMeta, SceneSource, Written};
-use crate::scenes::{AnyWorld, Scene, SourceFile};
+use crate::scenes::{AnyWorld, Scene};
 use crate::script::Limits;
 use clap::Args;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Recording options of `critterbox run`.
@@ -97,8 +97,32 @@ pub fn run_meta(args: &RunArgs, scene: &Scene, steps: u64) -> RunMeta {
     }
 }
 
+/// A run's recorder, and how many of the scene's script files are in the file so far.
+pub struct RunRecording {
+    rec: Recorder,
+    attached: usize,
+}
+
+impl RunRecording {
+    /// Records the step just taken, and attaches any script file the scene loaded during it (a
+    /// kind loaded from `on_step`), so even a run killed later can be re-simulated.
+    pub fn record(&mut self, scene: &Scene) -> anyhow::Result<()> {
+        self.rec.record(&scene.world)?;
+        self.attach_new(scene)
+    }
+
+    fn attach_new(&mut self, scene: &Scene) -> anyhow::Result<()> {
+        let new = scene.sources_since(self.attached);
+        if !new.is_empty() {
+            self.attached += new.len();
+            self.rec.attach(new)?;
+        }
+        Ok(())
+    }
+}
+
 /// Starts recording, unless `--no-record`.
-pub fn start(args: &RunArgs, scene: &Scene, steps: u64) -> anyhow::Result<Option<Recorder>> {
+pub fn start(args: &RunArgs, scene: &Scene, steps: u64) -> anyhow::Result<Option<RunRecording>> {
     if args.recording.no_record {
         return Ok(None);
     }
@@ -107,73 +131,26 @@ pub fn start(args: &RunArgs, scene: &Scene, steps: u64) -> anyhow::Result<Option
         None => path::new_path(&path::default_dir(), &scene.name),
     };
     let meta = run_meta(args, scene, steps);
-    Ok(Some(Recorder::create(
-        &file,
-        &meta,
-        &scene.sources,
-        &scene.world,
-    )?))
-}
-
-/// Kinds the scene loaded after it was set up (from `on_step`), which its `sources` do not
-/// list: found where the scene's kind search finds them.
-fn late_kinds(scene: &Scene) -> Vec<SourceFile> {
-    let Some(scene_file) = scene.sources.first() else {
-        return Vec::new();
-    };
-    let stem = |p: &str| {
-        Path::new(p)
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-    };
-    let known: Vec<String> = scene.sources.iter().filter_map(|s| stem(&s.path)).collect();
-    let names: Vec<String> = match &scene.world {
-        AnyWorld::D2(w) => w.kinds().iter().map(|(_, k)| k.name.clone()).collect(),
-        AnyWorld::D3(w) => w.kinds().iter().map(|(_, k)| k.name.clone()).collect(),
-    };
-    let dir = Path::new(&scene_file.path)
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    let search = [
-        dir.join("../kinds"),
-        dir.join("kinds"),
-        dir.clone(),
-        PathBuf::from("scripts/kinds"),
-    ];
-    let mut found = Vec::new();
-    for name in names {
-        if name == "ball" || name == "wall" || known.contains(&name) {
-            continue;
-        }
-        if let Some(p) = search
-            .iter()
-            .map(|d| d.join(format!("{name}.rhai")))
-            .find(|p| p.is_file())
-        {
-            if let Ok(text) = std::fs::read_to_string(&p) {
-                found.push(SourceFile {
-                    path: p.display().to_string(),
-                    text,
-                });
-            }
-        }
-    }
-    found
+    let rec = Recorder::create(&file, &meta, &scene.sources, &scene.world)?;
+    Ok(Some(RunRecording {
+        rec,
+        attached: scene.sources.len(),
+    }))
 }
 
 /// Closes the recording after the run and says where it is.
 pub fn finish(
-    recorder: Option<Recorder>,
+    recorder: Option<RunRecording>,
     scene: &Scene,
     outcome: &str,
     reason: &str,
     out: &mut dyn Write,
 ) -> anyhow::Result<()> {
-    let Some(mut rec) = recorder else {
+    let Some(mut run) = recorder else {
         return Ok(());
     };
-    rec.attach(late_kinds(scene))?;
+    run.attach_new(scene)?;
+    let rec = run.rec;
     let end = EndMeta {
         steps: scene.world.step_count(),
         outcome: outcome.into(),
@@ -186,17 +163,18 @@ pub fn finish(
 
 /// Records the error that stopped the run and closes the file, before the error is reported.
 pub fn fail(
-    recorder: Option<Recorder>,
+    recorder: Option<RunRecording>,
     scene: &Scene,
     error: &anyhow::Error,
     out: &mut dyn Write,
 ) -> anyhow::Result<()> {
-    let Some(mut rec) = recorder else {
+    let Some(mut run) = recorder else {
         return Ok(());
     };
     let message = format!("{error:#}");
+    run.attach_new(scene)?;
+    let mut rec = run.rec;
     rec.record_error(&scene.world, &message)?;
-    rec.attach(late_kinds(scene))?;
     let end = EndMeta {
         steps: scene.world.step_count(),
         outcome: "error".into(),

@@ -132,7 +132,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             }
         };
         if let Some(r) = &mut recorder {
-            r.record(&scene.world)?;
+            r.record(&scene)?;
         }
         if let Some(reason) = outcome {
             stopped = Some((scene.world.step_count(), reason));

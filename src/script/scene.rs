@@ -611,6 +611,15 @@ pub(crate) fn load(
     let sources = rt.sources.borrow().clone();
     let mut scene = Scene::new(name, world, rt.host.scene_steps.get().unwrap_or(600));
     scene.sources = sources;
+    let loaded = rt.clone();
+    scene.loaded_since = Some(Box::new(move |n| {
+        loaded
+            .sources
+            .borrow()
+            .get(n..)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default()
+    }));
     if let Some(on_step) = on_step {
         scene.on_step = Some(Box::new(move |world: &mut AnyWorld| on_step.call(world)));
     }
