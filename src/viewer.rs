@@ -428,18 +428,12 @@ impl Frame {
                 .collect();
         }
         let n = w.critters().len();
-        f.kind.clear();
-        f.kind.reserve(n);
-        f.id.clear();
-        f.id.reserve(n);
-        f.health.clear();
-        f.health.reserve(n);
-        f.radius.clear();
-        f.radius.reserve(n);
-        f.pos.clear();
-        f.pos.reserve(n);
-        f.vel.clear();
-        f.vel.reserve(n);
+        refill(&mut f.kind, n);
+        refill(&mut f.id, n);
+        refill(&mut f.health, n);
+        refill(&mut f.radius, n);
+        refill(&mut f.pos, n);
+        refill(&mut f.vel, n);
         // The same sums, in the same order, as World::kinetic_energy and World::momentum.
         let mut energy = 0.0;
         let mut momentum = V::zero();
@@ -473,6 +467,12 @@ impl Frame {
         f.deaths.clone_from(&events.deaths);
         f.log.clone_from(&events.log);
     }
+}
+
+/// Empties a reused buffer and makes room for `n` items, so filling it does not reallocate.
+fn refill<T>(v: &mut Vec<T>, n: usize) {
+    v.clear();
+    v.reserve(n);
 }
 
 /// What was last logged in full for a kind: the critters (ids, health bits, radius bits). While

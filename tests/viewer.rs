@@ -17,13 +17,12 @@ fn root() -> PathBuf {
 /// One point's coordinates at each step: (step, coordinates).
 type Track = Vec<(i64, Vec<f64>)>;
 
-/// (entity paths, steps on the `step` timeline, the track of one entity's n-th point).
-fn read_rrd(file: &Path, entity: &str, index: usize) -> (Vec<String>, usize, Track) {
+/// Runs one of the Python readers in `tests/python` on an .rrd file; its standard output.
+fn python_reader(script: &str, file: &Path, args: &[&str]) -> Vec<u8> {
     let out = Command::new(python())
-        .arg(root().join("tests/python/rrd_summary.py"))
+        .arg(root().join("tests/python").join(script))
         .arg(file)
-        .arg(entity)
-        .arg(index.to_string())
+        .args(args)
         .output()
         .expect("python runs");
     assert!(
@@ -31,7 +30,13 @@ fn read_rrd(file: &Path, entity: &str, index: usize) -> (Vec<String>, usize, Tra
         "reading the .rrd failed (is rerun-sdk==0.36.3 installed? pip install rerun-sdk==0.36.3):\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("the reader prints JSON");
+    out.stdout
+}
+
+/// (entity paths, steps on the `step` timeline, the track of one entity's n-th point).
+fn read_rrd(file: &Path, entity: &str, index: usize) -> (Vec<String>, usize, Track) {
+    let out = python_reader("rrd_summary.py", file, &[entity, &index.to_string()]);
+    let v: serde_json::Value = serde_json::from_slice(&out).expect("the reader prints JSON");
     let entities = v["entities"]
         .as_array()
         .expect("entities")
@@ -125,18 +130,7 @@ fn a_saved_run_has_the_entities_steps_and_positions_of_the_run() {
 /// Every logged value of a Rerun file, one sorted line each, leaving out the wall-clock step
 /// times (`/stats/step_ms`).
 fn dump_rrd(file: &Path) -> Vec<String> {
-    let out = Command::new(python())
-        .arg(root().join("tests/python/rrd_dump.py"))
-        .arg(file)
-        .arg("/stats/step_ms")
-        .output()
-        .expect("python runs");
-    assert!(
-        out.status.success(),
-        "reading the .rrd failed (is rerun-sdk==0.36.3 installed? pip install rerun-sdk==0.36.3):\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout)
+    String::from_utf8(python_reader("rrd_dump.py", file, &["/stats/step_ms"]))
         .expect("utf-8")
         .lines()
         .map(str::to_string)
