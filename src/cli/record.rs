@@ -6,7 +6,6 @@ use crate::recording::keyframes::default_record_every;
 use crate::recording::meta::utc_now;
 use crate::recording::{path, EndMeta, Recorder, RunMeta, SceneSource, Written};
 use crate::scenes::{AnyWorld, Scene};
-use crate::script::Limits;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -79,14 +78,7 @@ pub fn run_meta(args: &RunArgs, scene: &Scene, steps: u64) -> RunMeta {
         border: format!("{:?}", world.border()).to_lowercase(),
         n: args.n,
         sets: args.sets.clone(),
-        limits: Limits {
-            max_operations: args.max_ops,
-            max_spawns_per_step: args.max_spawns,
-            max_call_levels: args.max_call_depth,
-            max_string_size: args.max_string,
-            max_array_size: args.max_array,
-            max_map_size: args.max_map,
-        },
+        limits: super::run::limits(args),
         command_line: std::env::args().collect(),
         record_every: args
             .recording

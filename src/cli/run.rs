@@ -220,14 +220,7 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         sets.push((k.trim().to_string(), v.trim().to_string()));
     }
     let options = ScriptOptions {
-        limits: Limits {
-            max_operations: args.max_ops,
-            max_spawns_per_step: args.max_spawns,
-            max_call_levels: args.max_call_depth,
-            max_string_size: args.max_string,
-            max_array_size: args.max_array,
-            max_map_size: args.max_map,
-        },
+        limits: limits(args),
         seed: args.seed,
         ..ScriptOptions::default()
     };
@@ -240,6 +233,18 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
 
 fn parse_method(s: &str) -> Result<crate::method::Method, String> {
     s.parse()
+}
+
+/// The script limits the command line asks for.
+pub(crate) fn limits(args: &RunArgs) -> Limits {
+    Limits {
+        max_operations: args.max_ops,
+        max_spawns_per_step: args.max_spawns,
+        max_call_levels: args.max_call_depth,
+        max_string_size: args.max_string,
+        max_array_size: args.max_array,
+        max_map_size: args.max_map,
+    }
 }
 
 pub(crate) fn progress_bar(steps: u64) -> ProgressBar {
