@@ -148,6 +148,11 @@ impl<V: Vector> CritterSet<V> {
         self.slots.par_iter()
     }
 
+    /// Every slot, in order (empty ones are `None`).
+    pub(crate) fn slot_slice(&self) -> &[Option<Critter<V>>] {
+        &self.slots
+    }
+
     /// The free slots, in the order they are kept (the last is reused first), as the ids their
     /// next critters will get.
     pub fn free_ids(&self) -> impl Iterator<Item = CritterId> + '_ {

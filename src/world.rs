@@ -875,21 +875,6 @@ impl<V: Vector> World<V> {
     }
 
     fn stage_broad_phase(&mut self) {
-        // New critters and changed priorities need their rule class (rare; sequential).
-        let unset = |c: &Critter<V>| c.alive && c.class == CLASS_UNSET;
-        let any_unset = if self.critters.len() >= PARALLEL_MIN {
-            use rayon::prelude::*;
-            self.critters
-                .par_slots()
-                .any(|s| s.as_ref().is_some_and(unset))
-        } else {
-            self.critters.iter().any(unset)
-        };
-        if any_unset {
-            for c in self.critters.iter_mut().filter(|c| unset(c)) {
-                c.class = self.rules.class_of(&self.kinds, c);
-            }
-        }
         let object = |c: &Critter<V>| -> Option<BroadObject<V>> {
             if !c.alive {
                 return None;
@@ -905,24 +890,45 @@ impl<V: Vector> World<V> {
                 is_wall,
             })
         };
-        if self.critters.len() >= PARALLEL_MIN {
-            use rayon::prelude::*;
-            self.objs.clear();
-            self.objs.par_extend(
-                self.critters
-                    .par_slots()
-                    .filter_map(|s| s.as_ref().and_then(object)),
-            );
+        // What the same pass learns on the way, so no other pass over the critters is needed.
+        let survey = |c: &Critter<V>| Survey {
+            unset: c.alive && c.class == CLASS_UNSET,
+            largest_radius: if c.alive && !c.is_wall() {
+                c.radius
+            } else {
+                0.0
+            },
+        };
+        let seen = if self.critters.len() >= PARALLEL_MIN {
+            filter_map_in_order(
+                self.critters.slot_slice(),
+                &mut self.objs,
+                |s| s.as_ref().and_then(object),
+                |s| s.as_ref().map_or(Survey::default(), survey),
+                Survey::and,
+            )
         } else {
             self.objs.clear();
-            self.objs.extend(self.critters.iter().filter_map(object));
+            let mut seen = Survey::default();
+            for c in self.critters.iter() {
+                seen = seen.and(survey(c));
+                if let Some(o) = object(c) {
+                    self.objs.push(o);
+                }
+            }
+            seen
+        };
+        // New critters and changed priorities need their rule class (rare; sequential).
+        if seen.unset {
+            for c in self
+                .critters
+                .iter_mut()
+                .filter(|c| c.alive && c.class == CLASS_UNSET)
+            {
+                c.class = self.rules.class_of(&self.kinds, c);
+            }
         }
-        let largest_radius = self
-            .objs
-            .iter()
-            .filter(|o| !o.is_wall)
-            .map(|o| o.half.get(0))
-            .fold(0.0, f64::max);
+        let largest_radius = seen.largest_radius;
         // Wall pairs are tested after the disk pairs have been separated (see the response), and
         // a separation moves a disk by at most about its radius: widen walls' boxes by that much.
         if !self.walls.is_empty() {
@@ -1239,8 +1245,102 @@ fn hash_bytes(h: &mut StateHasher, bytes: &[u8]) {
     }
 }
 
+/// What the broad phase's input pass learns about the critters on the way.
+#[derive(Clone, Copy, Debug, Default)]
+struct Survey {
+    /// Some live critter has no rule class yet.
+    unset: bool,
+    /// The largest radius of a live disk (0 if none).
+    largest_radius: f64,
+}
+
+impl Survey {
+    fn and(self, other: Survey) -> Survey {
+        Survey {
+            unset: self.unset || other.unset,
+            largest_radius: self.largest_radius.max(other.largest_radius),
+        }
+    }
+}
+
+/// `out` = `items` filtered and mapped by `f`, in order, computed on rayon's threads into `out`'s
+/// own buffer: each chunk counts its outputs (and sums up `survey` of its items with `and`),
+/// then each fills its own part of `out`. So the result is the sequential one for any thread
+/// count, and a buffer reused from step to step allocates nothing (rayon's own unindexed collect
+/// builds fresh vectors every call and copies them together: at 100,000 critters that was page
+/// faults and copies every step). Returns the chunks' surveys combined in order.
+fn filter_map_in_order<T: Sync, U: Copy + Send, S: Copy + Send + Default>(
+    items: &[T],
+    out: &mut Vec<U>,
+    f: impl Fn(&T) -> Option<U> + Sync,
+    survey: impl Fn(&T) -> S + Sync,
+    and: impl Fn(S, S) -> S + Sync,
+) -> S {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    let counts: Vec<(usize, S)> = items
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            chunk.iter().fold((0, S::default()), |(n, s), t| {
+                (n + f(t).is_some() as usize, and(s, survey(t)))
+            })
+        })
+        .collect();
+    let seen = counts.iter().fold(S::default(), |s, &(_, c)| and(s, c));
+    out.clear();
+    let Some(first) = items.iter().find_map(&f) else {
+        return seen;
+    };
+    out.resize(counts.iter().map(|&(n, _)| n).sum(), first);
+    let mut parts = Vec::with_capacity(counts.len());
+    let mut rest = out.as_mut_slice();
+    for &(n, _) in &counts {
+        let (part, tail) = rest.split_at_mut(n);
+        parts.push(part);
+        rest = tail;
+    }
+    items
+        .par_chunks(CHUNK)
+        .zip(parts)
+        .for_each(|(chunk, part)| {
+            for (slot, u) in part.iter_mut().zip(chunk.iter().filter_map(&f)) {
+                *slot = u;
+            }
+        });
+    seen
+}
+
 /// "(1, 2.5)" or "(1, 2.5, 0)".
 pub fn fmt_vec<V: Vector>(v: V) -> String {
     let parts: Vec<String> = (0..V::DIM).map(|a| format!("{}", v.get(a))).collect();
     format!("({})", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn filter_map_in_order_matches_the_sequential_filter_map_on_any_thread_count() {
+        // Sizes around the chunk size, items that are mostly kept, mostly dropped, or all
+        // dropped; the survey (a sum) must match too.
+        for n in [0usize, 1, 7, 4095, 4096, 4097, 12_289] {
+            for keep_every in [1usize, 3, 1000, usize::MAX] {
+                let items: Vec<usize> = (0..n).collect();
+                let f = |&i: &usize| (i % keep_every == 0).then_some(i as u64 * 3);
+                let expected: Vec<u64> = items.iter().filter_map(f).collect();
+                for threads in [1, 3] {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .expect("a pool");
+                    let mut out = vec![99u64; 5]; // stale contents must not survive
+                    let sum = pool
+                        .install(|| filter_map_in_order(&items, &mut out, f, |&i| i, |a, b| a + b));
+                    assert_eq!(out, expected, "n {n}, keep every {keep_every}");
+                    assert_eq!(sum, n * n.saturating_sub(1) / 2, "n {n}");
+                }
+            }
+        }
+    }
 }
