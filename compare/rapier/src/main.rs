@@ -37,7 +37,8 @@ impl Rapier {
         let mut handles = Vec::new();
         for c in world.critters().iter() {
             if let Some(wall) = c.wall() {
-                let body = bodies.insert(RigidBodyBuilder::fixed().translation(Vector::new(c.pos.x, c.pos.y)));
+                let body = bodies
+                    .insert(RigidBodyBuilder::fixed().translation(Vector::new(c.pos.x, c.pos.y)));
                 let collider = ColliderBuilder::cuboid(wall.half.x, wall.half.y)
                     .restitution(1.0)
                     .friction(0.0)
@@ -113,30 +114,65 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn main() {
+const USAGE: &str = "\
+critterbox against rapier2d-f64 on the standard 2D gas, in one process
+
+Usage: critterbox-vs-rapier [N ...] [--steps S] [--rounds R] [--drift-steps D]
+
+  N                critter counts to compare (default: 1000 10000 100000)
+  --steps S        steps per timed round (default 20)
+  --rounds R       alternating rounds; the medians are reported (default 7)
+  --drift-steps D  steps over which kinetic energy drift is measured (default 300)";
+
+/// The command line, or a message saying what is wrong with it.
+fn parse(
+    mut args: impl Iterator<Item = String>,
+) -> Result<(Vec<usize>, usize, usize, usize), String> {
     let mut sizes = Vec::new();
     let (mut steps, mut rounds, mut drift_steps) = (20usize, 7usize, 300usize);
-    let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
-        let mut number = |what: &str| -> usize {
+        let mut number = |what: &str| -> Result<usize, String> {
             args.next()
                 .and_then(|s| s.parse().ok())
-                .unwrap_or_else(|| panic!("{what} needs a whole number"))
+                .filter(|&n| n > 0)
+                .ok_or_else(|| format!("{what} needs a whole number above 0"))
         };
         match a.as_str() {
-            "--steps" => steps = number("--steps"),
-            "--rounds" => rounds = number("--rounds"),
-            "--drift-steps" => drift_steps = number("--drift-steps"),
-            n => sizes.push(n.parse::<usize>().unwrap_or_else(|_| panic!("unknown argument {n}"))),
+            "-h" | "--help" => return Err(String::new()),
+            "--steps" => steps = number("--steps")?,
+            "--rounds" => rounds = number("--rounds")?,
+            "--drift-steps" => drift_steps = number("--drift-steps")?,
+            n => match n.parse::<usize>() {
+                Ok(n) if n > 0 => sizes.push(n),
+                _ => return Err(format!("unknown argument {n:?}")),
+            },
         }
     }
+    Ok((sizes, steps, rounds, drift_steps))
+}
+
+fn main() {
+    let (mut sizes, steps, rounds, drift_steps) = match parse(std::env::args().skip(1)) {
+        Ok(parsed) => parsed,
+        Err(message) if message.is_empty() => {
+            println!("{USAGE}");
+            return;
+        }
+        Err(message) => {
+            eprintln!("error: {message}\n\n{USAGE}");
+            std::process::exit(2);
+        }
+    };
     if sizes.is_empty() {
         sizes = vec![1_000, 10_000, 100_000];
     }
     println!("| N | critterbox ms/step | rapier2d-f64 ms/step | rapier / critterbox | critterbox KE drift | rapier KE drift |");
     println!("|---|---|---|---|---|---|");
     for &n in &sizes {
-        let params = GasParams { n, ..GasParams::default() };
+        let params = GasParams {
+            n,
+            ..GasParams::default()
+        };
         let mut ours = gas::<DVec2>(&params).expect("the gas builds");
         let mut theirs = Rapier::from(&ours);
         // Energy drift over `drift_steps` steps, from the same start.
