@@ -69,7 +69,7 @@ pub fn contains<V: Vector>(topo: &Topology<V>, outer: &Critter<V>, inner: &Critt
 /// Returns the impulse magnitude given to `arg` along the normal.
 #[inline]
 pub fn respond<V: Vector>(caller: &mut Critter<V>, arg: &mut Critter<V>, c: &Contact<V>) -> f64 {
-    let (im1, im2) = (caller.inv_mass, arg.inv_mass);
+    let (im1, im2) = (caller.inv_mass(), arg.inv_mass());
     let im = im1 + im2;
     if im == 0.0 {
         return 0.0; // two fixed critters: nothing can move

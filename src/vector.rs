@@ -29,6 +29,9 @@ pub trait Vector:
     const DIM: usize;
     /// An orthonormal frame, used to orient walls: a unit direction in 2D, a rotation matrix in 3D.
     type Frame: Copy + Debug + PartialEq + Send + Sync;
+    /// What aligns a [`crate::critter::Critter`] of this dimension (a zero-length array of it is
+    /// one of its fields): 64 bytes in 2D, so a critter's hot fields share one cache line.
+    type CritterAlign: Clone + Copy + Debug + Send + Sync;
 
     /// The zero vector.
     fn zero() -> Self;
@@ -75,6 +78,7 @@ pub trait Vector:
 impl Vector for DVec2 {
     const DIM: usize = 2;
     type Frame = DVec2;
+    type CritterAlign = Align64;
 
     #[inline]
     fn zero() -> Self {
@@ -128,6 +132,7 @@ impl Vector for DVec2 {
 impl Vector for DVec3 {
     const DIM: usize = 3;
     type Frame = DMat3;
+    type CritterAlign = u64;
 
     #[inline]
     fn zero() -> Self {
@@ -195,3 +200,8 @@ mod tests {
         assert!((back - v).length() < 1e-14);
     }
 }
+
+/// A zero-sized type aligned to a cache line (see [`Vector::CritterAlign`]).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(align(64))]
+pub struct Align64;

@@ -543,7 +543,7 @@ impl<V: Vector> World<V> {
             vel: V::zero(),
             radius,
             mass: f64::INFINITY,
-            inv_mass: 0.0,
+            _align: [],
             priority: CP_WALL,
             restitution: 1.0,
             health: 1.0,
@@ -675,7 +675,7 @@ impl<V: Vector> World<V> {
             vel: spec.vel,
             radius,
             mass,
-            inv_mass: if fixed { 0.0 } else { 1.0 / mass },
+            _align: [],
             priority,
             restitution,
             health,
@@ -931,9 +931,14 @@ impl<V: Vector> World<V> {
         let largest_radius = seen.largest_radius;
         // Wall pairs are tested after the disk pairs have been separated (see the response), and
         // a separation moves a disk by at most about its radius: widen walls' boxes by that much.
-        if !self.walls.is_empty() {
-            for o in self.objs.iter_mut().filter(|o| o.is_wall) {
-                o.half += V::splat(largest_radius);
+        // The objects are in slot order, so each wall is found by a binary search rather than
+        // a pass over all of them.
+        for wall in &self.walls {
+            if let Ok(i) = self.objs.binary_search_by_key(&wall.index, |o| o.slot) {
+                let o = &mut self.objs[i];
+                if o.is_wall {
+                    o.half += V::splat(largest_radius);
+                }
             }
         }
         self.broad

@@ -195,7 +195,7 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
             vel,
             radius: s.radius.0[i],
             mass,
-            inv_mass: if fixed { 0.0 } else { 1.0 / mass },
+            _align: [],
             priority: s.priority.0[i],
             restitution: s.restitution.0[i],
             health: s.health.0[i],
