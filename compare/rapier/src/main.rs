@@ -117,19 +117,28 @@ fn median(mut v: Vec<f64>) -> f64 {
 const USAGE: &str = "\
 critterbox against rapier2d-f64 on the standard 2D gas, in one process
 
-Usage: critterbox-vs-rapier [N ...] [--steps S] [--rounds R] [--drift-steps D]
+Usage: critterbox-vs-rapier [N ...] [--steps S] [--rounds R] [--drift-steps D] [--threads T]
 
   N                critter counts to compare (default: 1000 10000 100000)
   --steps S        steps per timed round (default 20)
   --rounds R       alternating rounds; the medians are reported (default 7)
-  --drift-steps D  steps over which kinetic energy drift is measured (default 300)";
+  --drift-steps D  steps over which kinetic energy drift is measured (default 300)
+  --threads T      critterbox's threads (default 1, as rapier here; its stages go parallel
+                   from 20,000 critters)";
 
-/// The command line, or a message saying what is wrong with it.
-fn parse(
-    mut args: impl Iterator<Item = String>,
-) -> Result<(Vec<usize>, usize, usize, usize), String> {
+/// The command line.
+struct Args {
+    sizes: Vec<usize>,
+    steps: usize,
+    rounds: usize,
+    drift_steps: usize,
+    threads: usize,
+}
+
+/// The command line, or a message saying what is wrong with it (empty for --help).
+fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut sizes = Vec::new();
-    let (mut steps, mut rounds, mut drift_steps) = (20usize, 7usize, 300usize);
+    let (mut steps, mut rounds, mut drift_steps, mut threads) = (20, 7, 300, 1);
     while let Some(a) = args.next() {
         let mut number = |what: &str| -> Result<usize, String> {
             args.next()
@@ -142,17 +151,30 @@ fn parse(
             "--steps" => steps = number("--steps")?,
             "--rounds" => rounds = number("--rounds")?,
             "--drift-steps" => drift_steps = number("--drift-steps")?,
+            "--threads" => threads = number("--threads")?,
             n => match n.parse::<usize>() {
                 Ok(n) if n > 0 => sizes.push(n),
                 _ => return Err(format!("unknown argument {n:?}")),
             },
         }
     }
-    Ok((sizes, steps, rounds, drift_steps))
+    Ok(Args {
+        sizes,
+        steps,
+        rounds,
+        drift_steps,
+        threads,
+    })
 }
 
 fn main() {
-    let (mut sizes, steps, rounds, drift_steps) = match parse(std::env::args().skip(1)) {
+    let Args {
+        mut sizes,
+        steps,
+        rounds,
+        drift_steps,
+        threads,
+    } = match parse(std::env::args().skip(1)) {
         Ok(parsed) => parsed,
         Err(message) if message.is_empty() => {
             println!("{USAGE}");
@@ -166,6 +188,14 @@ fn main() {
     if sizes.is_empty() {
         sizes = vec![1_000, 10_000, 100_000];
     }
+    if let Err(e) = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+    {
+        eprintln!("error: cannot start {threads} threads: {e}");
+        std::process::exit(1);
+    }
+    println!("critterbox on {threads} thread(s), rapier2d-f64 on one\n");
     println!("| N | critterbox ms/step | rapier2d-f64 ms/step | rapier / critterbox | critterbox KE drift | rapier KE drift |");
     println!("|---|---|---|---|---|---|");
     for &n in &sizes {
