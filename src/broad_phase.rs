@@ -790,7 +790,10 @@ mod tests {
             .collect();
         assert_eq!(typical_width(&objs, width), 4.0);
         // Only walls: the smallest of them.
-        assert_eq!(typical_width(&[disk(7.0, true), disk(5.0, true)], width), 10.0);
+        assert_eq!(
+            typical_width(&[disk(7.0, true), disk(5.0, true)], width),
+            10.0
+        );
         // Radii 1..=100_000 in order: an even sample of about 1,000 has its median near the
         // middle, far from the smallest width (2).
         let many: Vec<_> = (1..=100_000).map(|r| disk(r as f64, false)).collect();
