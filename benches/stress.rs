@@ -3,7 +3,8 @@
 //!
 //! * `uniform`: the standard gas (radius 0.5, packing fraction 0.2);
 //! * `radii_x100`: radii spread log-uniformly over a factor of 100 (0.05 to 5), packing 0.2,
-//!   placed at random, largest first;
+//!   placed at random, largest first (and `radii_x100_grid`, the same with the grid rebuilt
+//!   every step instead of the Verlet list);
 //! * `pile_9_layers`, `pile_90_layers`: disks of radius 0.5 dropped under gravity (restitution
 //!   0.5) in a box 1000 or 100 wide and settled for 900 steps into a pile about 9 or 90 layers
 //!   deep, so nearly every disk touches its neighbours.
