@@ -4,8 +4,8 @@
 //! on the 10,000-critter gas (`cargo bench --bench recording`; the figures and the method are in
 //! docs/recording-format.md).
 //!
-//! K does not change the cost of what every step records (hash, totals and events); the model
-//! keeps that figure only so the docs can state the whole cost in one place.
+//! K does not change the cost of what every step records (hash, totals and events), so that
+//! cost is not part of the model (docs/recording-format.md reports it).
 //!
 //! The model is conservative: it counts the writer thread's work (JSON, the Foxglove scene,
 //! zstd) as if it ran on the simulation's core, because on a shared two-core machine it often
@@ -16,8 +16,6 @@
 pub struct CostModel {
     /// A gas step, per critter.
     pub step: f64,
-    /// Every step on the simulation thread: hash, totals and events, per critter.
-    pub per_step: f64,
     /// A keyframe on the simulation thread: copying the critters into columns, per critter.
     pub capture: f64,
     /// A keyframe on the writer thread: JSON, the Foxglove scene, zstd, per critter.
@@ -27,7 +25,6 @@ pub struct CostModel {
 /// The measured model (see the module docs).
 pub const MEASURED: CostModel = CostModel {
     step: 29.0,
-    per_step: 5.4,
     capture: 12.8,
     encode: 983.0,
 };
@@ -98,7 +95,6 @@ mod tests {
         // critter) gave K = 1200.
         let before = CostModel {
             step: 95.0,
-            per_step: 8.1,
             capture: 19.0,
             encode: 1340.0,
         };
