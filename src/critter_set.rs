@@ -140,14 +140,6 @@ impl<V: Vector> CritterSet<V> {
         self.slots.par_iter_mut().filter_map(Option::as_mut)
     }
 
-    /// The slots, in order, in parallel.
-    pub fn par_slots(
-        &self,
-    ) -> impl rayon::iter::IndexedParallelIterator<Item = &Option<Critter<V>>> {
-        use rayon::prelude::*;
-        self.slots.par_iter()
-    }
-
     /// Every slot, in order (empty ones are `None`).
     pub(crate) fn slot_slice(&self) -> &[Option<Critter<V>>] {
         &self.slots
