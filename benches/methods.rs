@@ -6,7 +6,8 @@
 //! * kinetic-energy drift over 1e6 collisions at e = 1.
 //!
 //! `cargo bench --bench methods` runs criterion (throughput in collisions/s);
-//! `CRITTERBOX_REPORT=1 cargo bench --bench methods` prints the report instead.
+//! `CRITTERBOX_REPORT=1 cargo bench --bench methods` prints the report instead
+//! (`CRITTERBOX_REPORT=2d` or `=3d` for one system).
 
 use criterion::{Criterion, Throughput};
 use critterbox::glam::{DVec2, DVec3};
@@ -57,18 +58,39 @@ fn measure<V: Vector>(w: &mut World<V>, collisions: usize) -> (usize, f64, f64, 
     (impacts, secs, (e - e0) / e0, z)
 }
 
-fn report() {
+/// `which`: "2d" or "3d" for one system, anything else for both.
+fn report(which: &str) {
     // Warm up: relax from the grid start before measuring.
+    if which != "3d" {
+        report_2d();
+    }
+    if which != "2d" {
+        report_3d();
+    }
+}
+
+/// Collisions to measure: 2e6, or `CRITTERBOX_COLLISIONS` (shorter runs for profilers).
+fn collisions() -> usize {
+    std::env::var("CRITTERBOX_COLLISIONS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2_000_000)
+}
+
+fn report_2d() {
     let mut g2 = periodic_gas::<DVec2>(10_000, 0.4, 5.0);
     g2.run(1).expect("warm up");
-    let (c, s, drift, z) = measure(&mut g2, 2_000_000);
+    let (c, s, drift, z) = measure(&mut g2, collisions());
     println!(
         "2D 10,000 disks, phi 0.4, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4}",
         c as f64 / s
     );
+}
+
+fn report_3d() {
     let mut g3 = periodic_gas::<DVec3>(32_000, 0.4, 5.0);
     g3.run(1).expect("warm up");
-    let (c, s, drift, z) = measure(&mut g3, 2_000_000);
+    let (c, s, drift, z) = measure(&mut g3, collisions());
     println!(
         "3D 32,000 spheres, phi 0.40, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4} (literature 6.91)",
         c as f64 / s
@@ -76,8 +98,8 @@ fn report() {
 }
 
 fn main() {
-    if std::env::var_os("CRITTERBOX_REPORT").is_some() {
-        report();
+    if let Some(which) = std::env::var_os("CRITTERBOX_REPORT") {
+        report(&which.to_string_lossy());
         return;
     }
     let mut c = Criterion::default()

@@ -176,6 +176,23 @@ impl RuleCache {
         Ok(Some(rule))
     }
 
+    /// What `rule` would return for critters of classes `ca` and `cb`, when that is known without
+    /// the critters: `Some(None)` for an uncached class, `Some(rule)` for a computed pair, `None`
+    /// when the pair's roles are still to be computed.
+    #[inline]
+    pub(crate) fn cached(&self, ca: u32, cb: u32) -> Option<Option<PairRule>> {
+        let (ca, cb) = (ca as usize, cb as usize);
+        let n = self.uncached.len();
+        if ca >= n || cb >= n {
+            return None;
+        }
+        if self.uncached[ca] || self.uncached[cb] {
+            return Some(None);
+        }
+        let code = self.table[ca * n + cb];
+        (code != UNKNOWN).then(|| Some(decode(code)))
+    }
+
     /// Number of class pairs whose roles were computed from the hooks so far.
     pub fn computed(&self) -> u64 {
         self.lookups_computed

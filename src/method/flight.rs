@@ -24,12 +24,12 @@ use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
+use crate::method::queue::{Owned, Queue};
 use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_wall_ball};
 use crate::rules::PairRule;
 use crate::vector::Vector;
 use crate::world::{at_step, roles_order, StepStats, World};
-use std::cmp::{Ordering, Reverse};
-use std::collections::BinaryHeap;
+use std::cmp::Ordering;
 
 /// Relative shrink of contact distances used for prediction.
 pub const SKIN: f64 = 1e-10;
@@ -58,6 +58,17 @@ struct Ev {
     cb: u32,
 }
 
+impl Owned for Ev {
+    #[inline]
+    fn time(&self) -> f64 {
+        self.time
+    }
+    #[inline]
+    fn owner(&self) -> u32 {
+        self.a
+    }
+}
+
 impl PartialEq for Ev {
     fn eq(&self, o: &Self) -> bool {
         self.cmp(o) == Ordering::Equal
@@ -71,13 +82,10 @@ impl PartialOrd for Ev {
 }
 impl Ord for Ev {
     fn cmp(&self, o: &Self) -> Ordering {
-        self.time
-            .total_cmp(&o.time)
-            .then(self.a.cmp(&o.a))
-            .then(self.b.cmp(&o.b))
-            .then(self.kind.cmp(&o.kind))
-            .then(self.ca.cmp(&o.ca))
-            .then(self.cb.cmp(&o.cb))
+        // Ties are rare: compare the rest only on one.
+        self.time.total_cmp(&o.time).then_with(|| {
+            (self.a, self.b, self.kind, self.ca, self.cb).cmp(&(o.a, o.b, o.kind, o.ca, o.cb))
+        })
     }
 }
 
@@ -94,6 +102,65 @@ struct Body<V> {
     free: bool,
     alive: bool,
     wall: bool,
+    /// The critter's rule class (pair rules are looked up by class).
+    class: u32,
+}
+
+/// The critters in each cell, stored flat: cell `k` owns `data[k * stride..(k + 1) * stride]`,
+/// its count first, then its members. One stripe is one or two cache lines, where a vector per
+/// cell costs a miss for its header and another for its buffer.
+#[derive(Default)]
+struct Cells {
+    stride: usize,
+    data: Vec<u32>,
+}
+
+impl Cells {
+    /// Empties `total` cells with room for `cap` members each.
+    fn reset(&mut self, total: usize, cap: usize) {
+        self.stride = cap + 1;
+        self.data.clear();
+        self.data.resize(total * self.stride, 0);
+    }
+
+    #[inline]
+    fn members(&self, k: usize) -> &[u32] {
+        let at = k * self.stride;
+        let n = self.data[at] as usize;
+        &self.data[at + 1..at + 1 + n]
+    }
+
+    fn push(&mut self, k: usize, a: u32) {
+        let at = k * self.stride;
+        let n = self.data[at] as usize;
+        if n + 1 == self.stride {
+            self.grow();
+            return self.push(k, a);
+        }
+        self.data[at + 1 + n] = a;
+        self.data[at] = n as u32 + 1;
+    }
+
+    fn remove(&mut self, k: usize, a: u32) {
+        let at = k * self.stride;
+        let n = self.data[at] as usize;
+        if let Some(i) = self.data[at + 1..at + 1 + n].iter().position(|&x| x == a) {
+            self.data[at + 1 + i] = self.data[at + n];
+            self.data[at] = n as u32 - 1;
+        }
+    }
+
+    /// Doubles every cell's room (a cell filled up: rare, cells are sized for their load).
+    fn grow(&mut self) {
+        let (old, stride) = (std::mem::take(&mut self.data), self.stride);
+        let total = old.len() / stride;
+        self.reset(total, 2 * (stride - 1));
+        for k in 0..total {
+            let n = old[k * stride] as usize;
+            let dst = k * self.stride;
+            self.data[dst..dst + 1 + n].copy_from_slice(&old[k * stride..k * stride + 1 + n]);
+        }
+    }
 }
 
 /// Per-world scratch kept between steps so a step allocates nothing once warmed up.
@@ -102,18 +169,34 @@ pub(crate) struct Scratch<V> {
     body: Vec<Body<V>>,
     count: Vec<u32>,
     cell: Vec<u32>,
+    /// The coordinates of each critter's cell (`cell` unpacked, saving divisions).
+    coord: Vec<[i64; 3]>,
     last: Vec<u32>,
     last_t: Vec<f64>,
-    cells: Vec<Vec<u32>>,
+    cells: Cells,
     cell_walls: Vec<Vec<u32>>,
-    heap: BinaryHeap<Reverse<Ev>>,
+    /// Some wall is alive (otherwise `cell_walls` is not read).
+    has_walls: bool,
+    /// Each critter's next event.
+    heap: Queue<Ev>,
     /// The earliest event found so far by the running `predict_all`.
     cand: Option<Ev>,
     /// Pairs whose hook left them overlapping this step: not handed back at once again.
     stuck: std::collections::HashSet<u64>,
     dims: [usize; 3],
     side: [f64; 3],
+    /// Key offsets of the 3^D cells around an interior cell (none when an axis has fewer than
+    /// three cells: neighbours then repeat, and the general path dedups them).
+    offsets: Vec<isize>,
+    /// Per axis and direction (`axis * 2 + dir`), the offsets among `offsets` of the cells a
+    /// crossing that way brings into reach.
+    front: [Vec<isize>; 6],
+    /// Each critter's earliest pair or wall event from its last prediction, kept so that a cell
+    /// crossing only has to look at the cells it brings into reach (Rapaport's scheme).
+    best: Vec<Option<Ev>>,
     acc: V,
+    /// No acceleration: every flight is a straight line.
+    straight: bool,
     t_end: f64,
     tc: f64,
     budget: u64,
@@ -134,7 +217,7 @@ pub(crate) fn run<V: Vector>(
 ) -> Result<bool, Error> {
     let mut sc = std::mem::take(&mut world.flight);
     let out = run_with(world, &mut sc, acc, t_end, stats);
-    sc.heap.clear();
+    sc.heap.reset(0);
     world.flight = sc;
     out
 }
@@ -153,12 +236,17 @@ fn run_with<V: Vector>(
     }
     let mut processed = 0u64;
     let mut complete = true;
-    while let Some(Reverse(ev)) = sc.heap.pop() {
+    // Every branch below predicts the event's owner again (which replaces the event in the
+    // queue) or removes the event.
+    while let Some(ev) = sc.heap.peek() {
         if ev.time > t_end {
             break;
         }
         match validity(sc, &ev) {
-            Validity::Stale => continue,
+            Validity::Stale => {
+                sc.heap.remove(ev.a);
+                continue;
+            }
             Validity::PartnerChanged => {
                 predict_all(w, sc, ev.a, ev.time)?;
                 continue;
@@ -222,7 +310,7 @@ fn run_with<V: Vector>(
             CELL => {
                 cross_cell(w, sc, ev.a, ev.b, t);
                 refresh(w, sc, ev.a);
-                predict_all(w, sc, ev.a, t)?;
+                predict_after_crossing(w, sc, ev.a, ev.b, t)?;
             }
             _ => {
                 // RECHECK: continue a curved prediction that did not settle.
@@ -253,28 +341,16 @@ fn run_with<V: Vector>(
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     let n = w.critters.slot_count();
-    sc.heap.clear();
+    sc.heap.reset(n);
     sc.stuck.clear();
     for v in [&mut sc.count, &mut sc.cell, &mut sc.last] {
         v.clear();
         v.resize(n, NONE);
     }
     sc.count.iter_mut().for_each(|c| *c = 0);
-    sc.body.clear();
-    sc.body.resize(n, Body::default());
-    for a in 0..n as u32 {
-        refresh(w, sc, a);
-    }
-    sc.last_t.clear();
-    sc.last_t.resize(n, f64::NEG_INFINITY);
-    sc.acc = acc;
-    sc.t_end = t_end;
-    sc.tc = TC_FRACTION * w.dt;
-    sc.virial = 0.0;
-    sc.predictions = 0;
-    sc.pair_tests = 0;
     let mut rmax: f64 = 0.0;
     let mut disks = 0usize;
+    sc.has_walls = false;
     for c in w.critters.iter_mut() {
         if c.class == CLASS_UNSET {
             c.class = w.rules.class_of(&w.kinds, c);
@@ -283,7 +359,24 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
             rmax = rmax.max(c.radius);
             disks += 1;
         }
+        sc.has_walls |= c.alive && c.is_wall();
     }
+    sc.coord.clear();
+    sc.coord.resize(n, [0; 3]);
+    sc.body.clear();
+    sc.body.resize(n, Body::default());
+    for a in 0..n as u32 {
+        refresh(w, sc, a);
+    }
+    sc.last_t.clear();
+    sc.last_t.resize(n, f64::NEG_INFINITY);
+    sc.acc = acc;
+    sc.straight = acc.length_squared() == 0.0;
+    sc.t_end = t_end;
+    sc.tc = TC_FRACTION * w.dt;
+    sc.virial = 0.0;
+    sc.predictions = 0;
+    sc.pair_tests = 0;
     sc.budget = BUDGET_PER_CRITTER * disks as u64 + 10_000;
     // Cells at least one diameter wide, at most about 2 per disk.
     let size = w.topo.size();
@@ -307,20 +400,54 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
         };
     }
     sc.dims = dims;
+    sc.offsets.clear();
+    sc.front.iter_mut().for_each(Vec::clear);
+    sc.best.clear();
+    sc.best.resize(n, None);
+    if dims[..dim].iter().all(|&n| n >= 3) {
+        let reach = |axis: usize| if axis < dim { -1..=1isize } else { 0..=0 };
+        let (nx, nxy) = (dims[0] as isize, (dims[0] * dims[1]) as isize);
+        for dz in reach(2) {
+            for dy in reach(1) {
+                for dx in reach(0) {
+                    let o = dx + nx * dy + nxy * dz;
+                    sc.offsets.push(o);
+                    for (axis, d) in [dx, dy, dz].into_iter().enumerate() {
+                        if d != 0 {
+                            sc.front[axis * 2 + usize::from(d > 0)].push(o);
+                        }
+                    }
+                }
+            }
+        }
+    }
     let total: usize = dims[..dim].iter().product();
-    sc.cells.iter_mut().for_each(Vec::clear);
-    sc.cells.resize_with(total, Vec::new);
+    // Room for the fullest cell now, and some.
+    let mut load = std::mem::take(&mut sc.cells.data);
+    load.clear();
+    load.resize(total, 0);
+    for c in w.critters.iter() {
+        if c.alive && !c.is_wall() {
+            let k = cell_of(w, sc, c.pos);
+            sc.cell[c.id.index as usize] = k as u32;
+            sc.coord[c.id.index as usize] = coords(&dims, k);
+            load[k] += 1;
+        }
+    }
+    let fullest = load.iter().copied().max().unwrap_or(0) as usize;
+    sc.cells.data = load;
+    sc.cells.reset(total, (fullest + 2).max(7));
     sc.cell_walls.iter_mut().for_each(Vec::clear);
-    sc.cell_walls.resize_with(total, Vec::new);
+    sc.cell_walls
+        .resize_with(if sc.has_walls { total } else { 0 }, Vec::new);
     for c in w.critters.iter() {
         if !c.alive {
             continue;
         }
         match &c.shape {
             Shape::Disk => {
-                let k = cell_of(w, sc, c.pos);
-                sc.cell[c.id.index as usize] = k as u32;
-                sc.cells[k].push(c.id.index);
+                let k = sc.cell[c.id.index as usize] as usize;
+                sc.cells.push(k, c.id.index);
             }
             Shape::Wall(wall) => {
                 // Every cell a disk centre could be in while touching the wall.
@@ -405,6 +532,7 @@ fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
             free: !c.fixed && !c.is_wall(),
             alive: c.alive,
             wall: c.is_wall(),
+            class: c.class,
         },
         None => Body::default(),
     };
@@ -501,12 +629,162 @@ fn predict_all<V: Vector>(
 ) -> Result<(), Error> {
     let me = sc.body[a as usize];
     if !me.alive || me.wall {
+        sc.heap.remove(a);
         return Ok(());
     }
     sc.cand = None;
     sc.predictions += 1;
     let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
+    let dims = sc.dims;
+    let hc = sc.coord[a as usize];
+    let interior = !sc.offsets.is_empty()
+        && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= dims[ax] as i64);
+    if interior {
+        // The common case: the neighbours are fixed offsets away, no wrapping, no repeats.
+        for i in 0..sc.offsets.len() {
+            let k = (home as isize + sc.offsets[i]) as usize;
+            scan_cell(w, sc, a, k, t, mine)?;
+        }
+    } else {
+        scan_edge_neighbours(w, sc, a, home, t, mine)?;
+    }
+    finish_prediction(w, sc, a, home, t, mine)
+}
+
+/// Ends a prediction of `a` (in cell `home`) whose disk candidates are in: walls, then the
+/// pair and wall event kept as `best`, then borders and cells, and the earliest goes to the queue.
+fn finish_prediction<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    home: usize,
+    t: f64,
+    mine: (V, V, V),
+) -> Result<(), Error> {
+    if sc.has_walls {
+        for i in 0..sc.cell_walls[home].len() {
+            let b = sc.cell_walls[home][i];
+            predict_pair_or_wall(w, sc, a, b, t, mine)?;
+        }
+    }
+    sc.best[a as usize] = sc.cand;
+    predict_border(w, sc, a, t);
+    if sc.straight {
+        predict_cell_straight(w, sc, a, t, mine);
+    } else {
+        predict_cell(w, sc, a, t);
+    }
+    match sc.cand.take() {
+        Some(ev) => sc.heap.set(ev),
+        None => sc.heap.remove(a),
+    }
+    Ok(())
+}
+
+/// Predicts `a` after it crossed into a new cell (`tag`: the axis and direction). Rapaport's
+/// scheme: the pairs still in reach were predicted before (by `a`, or by the partner when its
+/// flight changed since), so only the cells the crossing brings into reach are new, and `a`'s
+/// kept `best` event stands for the rest while its partner has not changed. Otherwise (a
+/// changed partner, a curved flight, an edge cell) the full prediction.
+fn predict_after_crossing<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    tag: u32,
+    t: f64,
+) -> Result<(), Error> {
+    let home = sc.cell[a as usize] as usize;
+    let hc = sc.coord[a as usize];
+    let kept = sc.best[a as usize];
+    let kept_valid = kept.is_none_or(|ev| matches!(validity(sc, &ev), Validity::Valid));
+    let interior = !sc.offsets.is_empty()
+        && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= sc.dims[ax] as i64);
+    if !(sc.straight && kept_valid && interior && sc.body[a as usize].alive) {
+        return predict_all(w, sc, a, t);
+    }
+    sc.predictions += 1;
+    sc.cand = kept;
+    let mine = state_at(sc, a, t);
+    let front = std::mem::take(&mut sc.front[tag as usize]);
+    let mut out = Ok(());
+    for &o in &front {
+        let k = (home as isize + o) as usize;
+        out = scan_cell(w, sc, a, k, t, mine);
+        if out.is_err() {
+            break;
+        }
+    }
+    sc.front[tag as usize] = front;
+    out?;
+    finish_prediction(w, sc, a, home, t, mine)
+}
+
+/// Predicts `a` against the disks of cell `k`.
+#[inline(always)]
+fn scan_cell<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    k: usize,
+    t: f64,
+    mine: (V, V, V),
+) -> Result<(), Error> {
+    let n = sc.cells.members(k).len();
+    for i in 0..n {
+        let b = sc.cells.members(k)[i];
+        if b != a {
+            predict_disk(w, sc, a, b, t, mine)?;
+        }
+    }
+    Ok(())
+}
+
+/// Predicts `a` against disk `b` (a member of a cell). The common case, both flying straight,
+/// is inline; everything else goes to `predict_pair_or_wall`. Same result either way.
+#[inline(always)]
+fn predict_disk<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    b: u32,
+    t: f64,
+    mine: (V, V, V),
+) -> Result<(), Error> {
+    let body_b = &sc.body[b as usize];
+    if !sc.straight || body_b.wall || !body_b.alive {
+        return predict_pair_or_wall(w, sc, a, b, t, mine);
+    }
+    sc.pair_tests += 1;
+    let horizon = sc.t_end - t;
+    let (pb, vb, _) = state_at(sc, b, t);
+    let (pa, va, _) = mine;
+    let d = w.topo.delta(pa, pb);
+    let r = (sc.body[a as usize].radius + sc.body[b as usize].radius) * (1.0 - SKIN);
+    let s = if d.length_squared() < r * r {
+        0.0 // overlapping: collide now (approaching or not)
+    } else {
+        match toi_ball_ball(d, vb - va, r) {
+            Some(s) => s,
+            None => return Ok(()),
+        }
+    };
+    if horizon < 0.0 || s > horizon || sc.cand.is_some_and(|c| t + s > c.time) {
+        return Ok(());
+    }
+    offer_pair(w, sc, a, b, t, s, PAIR)
+}
+
+/// Predicts `a`, in cell `home` at the edge of the grid, against the disks of the cells around
+/// it: wrapped or cut at the border, each cell once.
+fn scan_edge_neighbours<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    home: usize,
+    t: f64,
+    mine: (V, V, V),
+) -> Result<(), Error> {
     let dims = sc.dims;
     let hc = coords(&dims, home);
     let small = dims[..V::DIM].iter().any(|&n| n < 3);
@@ -530,29 +808,8 @@ fn predict_all<V: Vector>(
                     seen[nseen] = k;
                     nseen += 1;
                 }
-                for i in 0..sc.cells[k].len() {
-                    let b = sc.cells[k][i];
-                    if b == a {
-                        continue;
-                    }
-                    predict_pair_or_wall(w, sc, a, b, t, mine)?;
-                }
+                scan_cell(w, sc, a, k, t, mine)?;
             }
-        }
-    }
-    for i in 0..sc.cell_walls[home].len() {
-        let b = sc.cell_walls[home][i];
-        predict_pair_or_wall(w, sc, a, b, t, mine)?;
-    }
-    predict_border(w, sc, a, t);
-    predict_cell(w, sc, a, t);
-    if let Some(ev) = sc.cand.take() {
-        sc.heap.push(Reverse(ev));
-        if sc.heap.len() > 3 * sc.count.len() + 1024 {
-            // Lazy invalidation leaves stale events behind; drop those whose owner has
-            // predicted again since, so the heap stays about one event per critter.
-            let count = &sc.count;
-            sc.heap.retain(|Reverse(e)| count[e.a as usize] == e.ca);
         }
     }
     Ok(())
@@ -578,7 +835,6 @@ fn predict_pair_or_wall<V: Vector>(
     }
     let (pa, va, aa) = mine;
     let is_wall = body_b.wall;
-    let just_met = sc.last[a as usize] == b && (is_wall || sc.last[b as usize] == a);
     let (kind, s) = if is_wall {
         let Some(cb) = w.critters.slot(b) else {
             return Ok(());
@@ -642,23 +898,47 @@ fn predict_pair_or_wall<V: Vector>(
         if s > horizon || sc.cand.is_some_and(|c| t + s > c.time) {
             return Ok(());
         }
-        let (ca, cb) = (
-            w.critters.slot(a).expect("live"),
-            w.critters.slot(b).expect("live"),
-        );
-        let rule = w
-            .rules
-            .rule(&w.kinds, &w.topo, ca, cb)
-            .map_err(|e| at_step(e, w.step_count))?;
+        offer_pair(w, sc, a, b, t, s, kind)?;
+    }
+    Ok(())
+}
+
+/// Offers the contact of `a` with `b` (a disk, or a wall) `s` after `t`, unless their rule says
+/// they don't collide, or they touch now and were just handled.
+#[inline(never)]
+fn offer_pair<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    b: u32,
+    t: f64,
+    s: f64,
+    kind: u8,
+) -> Result<(), Error> {
+    {
+        let (body_a, body_b) = (&sc.body[a as usize], &sc.body[b as usize]);
+        let rule = match w.rules.cached(body_a.class, body_b.class) {
+            Some(rule) => rule,
+            None => {
+                let (ca, cb) = (
+                    w.critters.slot(a).expect("live"),
+                    w.critters.slot(b).expect("live"),
+                );
+                w.rules
+                    .rule(&w.kinds, &w.topo, ca, cb)
+                    .map_err(|e| at_step(e, w.step_count))?
+            }
+        };
         if rule == Some(PairRule::DontCollide) {
             return Ok(());
         }
-        if s == 0.0 && (just_met || sc.stuck.contains(&pair_key(a, b))) {
-            return Ok(()); // the pair was handled; its hook chose to leave them so
+        if s == 0.0 {
+            let just_met = sc.last[a as usize] == b && (body_b.wall || sc.last[b as usize] == a);
+            if just_met || sc.stuck.contains(&pair_key(a, b)) {
+                return Ok(()); // the pair was handled; its hook chose to leave them so
+            }
         }
-        if s <= horizon {
-            push(sc, t + s, a, b, kind);
-        }
+        push(sc, t + s, a, b, kind);
     }
     Ok(())
 }
@@ -764,7 +1044,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
 #[allow(clippy::needless_range_loop)]
 fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let (p, v, acc) = state_at(sc, a, t);
-    let cc = coords(&sc.dims, sc.cell[a as usize] as usize);
+    let cc = sc.coord[a as usize];
     let mut best = (f64::INFINITY, 0u32);
     for axis in 0..V::DIM {
         let n = sc.dims[axis] as i64;
@@ -803,6 +1083,53 @@ fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     }
 }
 
+/// `predict_cell` for a straight flight (`mine`: position and velocity at `t`): only the side
+/// the critter moves towards can be crossed, at `gap / speed`, the time `predict_cell`'s general
+/// formulas give bit for bit.
+#[inline]
+#[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
+fn predict_cell_straight<V: Vector>(
+    w: &World<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    t: f64,
+    mine: (V, V, V),
+) {
+    let (p, v, _) = mine;
+    let cc = sc.coord[a as usize];
+    let wraps = w.topo.wraps();
+    let mut best = (f64::INFINITY, 0u32);
+    for axis in 0..V::DIM {
+        let n = sc.dims[axis] as i64;
+        let vx = v.get(axis);
+        if n == 1 || vx == 0.0 || vx.is_nan() {
+            continue; // not moving along the axis (or NaN): no crossing, as in `predict_cell`
+        }
+        let up = vx > 0.0;
+        if !wraps && (if up { cc[axis] == n - 1 } else { cc[axis] == 0 }) {
+            continue;
+        }
+        let lo = w.topo.min.get(axis) + cc[axis] as f64 * sc.side[axis];
+        let (bound, outward) = if up {
+            (lo + sc.side[axis], 1.0)
+        } else {
+            (lo, -1.0)
+        };
+        let gap = (bound - p.get(axis)) * outward;
+        let s = if gap <= 0.0 {
+            0.0
+        } else {
+            -(-gap) / (vx * outward)
+        };
+        if s < best.0 {
+            best = (s, axis as u32 * 2 + u32::from(up));
+        }
+    }
+    if best.0.is_finite() && t + best.0 <= sc.t_end {
+        push(sc, t + best.0, a, best.1, CELL);
+    }
+}
+
 #[allow(clippy::needless_range_loop)]
 fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32, t: f64) {
     advance(w, sc, a, t);
@@ -825,11 +1152,10 @@ fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize) {
     if old == new {
         return;
     }
-    if let Some(i) = sc.cells[old].iter().position(|&x| x == a) {
-        sc.cells[old].swap_remove(i);
-    }
-    sc.cells[new].push(a);
+    sc.cells.remove(old, a);
+    sc.cells.push(new, a);
     sc.cell[a as usize] = new as u32;
+    sc.coord[a as usize] = coords(&sc.dims, new);
 }
 
 /// After a hook ran: the critter may have died or been moved; put it in the right cell.
@@ -837,9 +1163,7 @@ fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     let old = sc.cell[a as usize] as usize;
     let Some(c) = w.critters.slot(a) else { return };
     if !c.alive {
-        if let Some(i) = sc.cells[old].iter().position(|&x| x == a) {
-            sc.cells[old].swap_remove(i);
-        }
+        sc.cells.remove(old, a);
         return;
     }
     let mut p = c.pos;

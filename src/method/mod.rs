@@ -15,6 +15,7 @@
 pub mod auto;
 pub mod event;
 pub(crate) mod flight;
+mod queue;
 pub mod swept;
 pub mod toi;
 
