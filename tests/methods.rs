@@ -174,6 +174,38 @@ fn event_gas_keeps_energy_and_momentum_and_never_overlaps() {
     }
 }
 
+/// A missed collision lets two spheres pass through each other; any overlap after any step
+/// would show one. Dense enough (packing 0.4, cells about one diameter) that most predictions
+/// after a cell crossing look only at the cells the crossing brings into reach.
+#[test]
+fn event_gas_in_3d_never_overlaps_after_any_step() {
+    let mut w = gas::<DVec3>(&GasParams {
+        n: 512,
+        packing: 0.4,
+        dt: 0.25,
+        border: Border::Wrap,
+        ..GasParams::default()
+    })
+    .unwrap();
+    w.set_method(Method::Event).unwrap();
+    let e0 = w.kinetic_energy();
+    for step in 0..40 {
+        w.step().unwrap();
+        let cs: Vec<_> = w.critters().iter().collect();
+        for (i, a) in cs.iter().enumerate() {
+            for b in &cs[i + 1..] {
+                let d = w.topology().delta(a.pos, b.pos).length();
+                assert!(d > 1.0 - 1e-9, "step {step}: overlap {d}");
+            }
+        }
+    }
+    let t = w.totals();
+    assert!(t.impacts > 5_000, "{} impacts", t.impacts);
+    assert_eq!(t.budget_exceeded, 0);
+    let e = w.kinetic_energy();
+    assert!(((e - e0) / e0).abs() < 1e-12, "{e} vs {e0}");
+}
+
 #[test]
 fn event_restitution_scales_relative_normal_speed() {
     let e = 0.5;

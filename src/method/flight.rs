@@ -90,14 +90,22 @@ impl Ord for Ev {
 }
 
 /// What predictions read about a critter, kept compact and contiguous (the critters themselves
-/// are large and scattered); refreshed whenever the flight or a hook changes the critter.
+/// are large and scattered); refreshed whenever the flight or a hook changes the critter. 48
+/// bytes in 2D, one cache line in 3D: what a pair test reads and nothing else.
 #[derive(Clone, Copy, Debug, Default)]
 struct Body<V> {
     pos: V,
     vel: V,
     /// The body's own clock: `pos` and `vel` hold at this time.
     t: f64,
+    /// The radius of a live disk; NaN for a wall or a dead critter (one test sends those to
+    /// the general path).
     radius: f64,
+}
+
+/// The rest of what the flight knows about a critter.
+#[derive(Clone, Copy, Debug, Default)]
+struct Meta {
     /// Accelerates with the flight's gravity (free disks).
     free: bool,
     alive: bool,
@@ -167,6 +175,7 @@ impl Cells {
 #[derive(Default)]
 pub(crate) struct Scratch<V> {
     body: Vec<Body<V>>,
+    meta: Vec<Meta>,
     count: Vec<u32>,
     cell: Vec<u32>,
     /// The coordinates of each critter's cell (`cell` unpacked, saving divisions).
@@ -365,13 +374,15 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     sc.coord.resize(n, [0; 3]);
     sc.body.clear();
     sc.body.resize(n, Body::default());
+    sc.meta.clear();
+    sc.meta.resize(n, Meta::default());
     for a in 0..n as u32 {
         refresh(w, sc, a);
     }
     sc.last_t.clear();
     sc.last_t.resize(n, f64::NEG_INFINITY);
-    sc.acc = acc;
     sc.straight = acc.length_squared() == 0.0;
+    sc.acc = if sc.straight { V::zero() } else { acc };
     sc.t_end = t_end;
     sc.tc = TC_FRACTION * w.dt;
     sc.virial = 0.0;
@@ -523,26 +534,46 @@ fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> usize {
 #[inline]
 fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
     let t = sc.body[a as usize].t;
-    sc.body[a as usize] = match w.critters.slot(a) {
-        Some(c) => Body {
-            pos: c.pos,
-            vel: c.vel,
-            t,
-            radius: c.radius,
-            free: !c.fixed && !c.is_wall(),
-            alive: c.alive,
-            wall: c.is_wall(),
-            class: c.class,
-        },
-        None => Body::default(),
+    let (body, meta) = match w.critters.slot(a) {
+        Some(c) => (
+            Body {
+                pos: c.pos,
+                vel: c.vel,
+                t,
+                radius: if c.alive && !c.is_wall() {
+                    c.radius
+                } else {
+                    f64::NAN
+                },
+            },
+            Meta {
+                free: !c.fixed && !c.is_wall(),
+                alive: c.alive,
+                wall: c.is_wall(),
+                class: c.class,
+            },
+        ),
+        None => (
+            Body {
+                radius: f64::NAN,
+                ..Body::default()
+            },
+            Meta::default(),
+        ),
     };
+    sc.body[a as usize] = body;
+    sc.meta[a as usize] = meta;
 }
 
 /// Position, velocity and acceleration of body `a` at time `t` (its own clock is `body.t`).
 #[inline]
 fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
     let b = &sc.body[a as usize];
-    let acc = if b.free { sc.acc } else { V::zero() };
+    let acc = if sc.straight || !sc.meta[a as usize].free {
+        V::zero()
+    } else {
+        sc.acc
+    };
     let h = t - b.t;
     if h == 0.0 {
         return (b.pos, b.vel, acc);
@@ -555,8 +586,8 @@ fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
 }
 
 fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
-    let b = sc.body[a as usize];
-    if !b.alive || b.wall {
+    let m = sc.meta[a as usize];
+    if !m.alive || m.wall {
         return;
     }
     let (p, v, _) = state_at(sc, a, t);
@@ -579,7 +610,7 @@ enum Validity {
 }
 
 fn validity<V: Vector>(sc: &Scratch<V>, ev: &Ev) -> Validity {
-    let alive = |x: u32| sc.body[x as usize].alive;
+    let alive = |x: u32| sc.meta[x as usize].alive;
     if !alive(ev.a) || sc.count[ev.a as usize] != ev.ca {
         return Validity::Stale;
     }
@@ -627,7 +658,7 @@ fn predict_all<V: Vector>(
     a: u32,
     t: f64,
 ) -> Result<(), Error> {
-    let me = sc.body[a as usize];
+    let me = sc.meta[a as usize];
     if !me.alive || me.wall {
         sc.heap.remove(a);
         return Ok(());
@@ -700,7 +731,7 @@ fn predict_after_crossing<V: Vector>(
     let kept_valid = kept.is_none_or(|ev| matches!(validity(sc, &ev), Validity::Valid));
     let interior = !sc.offsets.is_empty()
         && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= sc.dims[ax] as i64);
-    if !(sc.straight && kept_valid && interior && sc.body[a as usize].alive) {
+    if !(sc.straight && kept_valid && interior && sc.meta[a as usize].alive) {
         return predict_all(w, sc, a, t);
     }
     sc.predictions += 1;
@@ -751,8 +782,7 @@ fn predict_disk<V: Vector>(
     t: f64,
     mine: (V, V, V),
 ) -> Result<(), Error> {
-    let body_b = &sc.body[b as usize];
-    if !sc.straight || body_b.wall || !body_b.alive {
+    if !sc.straight || sc.body[b as usize].radius.is_nan() {
         return predict_pair_or_wall(w, sc, a, b, t, mine);
     }
     sc.pair_tests += 1;
@@ -826,7 +856,8 @@ fn predict_pair_or_wall<V: Vector>(
 ) -> Result<(), Error> {
     sc.pair_tests += 1;
     let (body_a, body_b) = (sc.body[a as usize], sc.body[b as usize]);
-    if !body_b.alive {
+    let meta_b = sc.meta[b as usize];
+    if !meta_b.alive {
         return Ok(());
     }
     let horizon = sc.t_end - t;
@@ -834,7 +865,7 @@ fn predict_pair_or_wall<V: Vector>(
         return Ok(());
     }
     let (pa, va, aa) = mine;
-    let is_wall = body_b.wall;
+    let is_wall = meta_b.wall;
     let (kind, s) = if is_wall {
         let Some(cb) = w.critters.slot(b) else {
             return Ok(());
@@ -916,8 +947,8 @@ fn offer_pair<V: Vector>(
     kind: u8,
 ) -> Result<(), Error> {
     {
-        let (body_a, body_b) = (&sc.body[a as usize], &sc.body[b as usize]);
-        let rule = match w.rules.cached(body_a.class, body_b.class) {
+        let (meta_a, meta_b) = (sc.meta[a as usize], sc.meta[b as usize]);
+        let rule = match w.rules.cached(meta_a.class, meta_b.class) {
             Some(rule) => rule,
             None => {
                 let (ca, cb) = (
@@ -933,7 +964,7 @@ fn offer_pair<V: Vector>(
             return Ok(());
         }
         if s == 0.0 {
-            let just_met = sc.last[a as usize] == b && (body_b.wall || sc.last[b as usize] == a);
+            let just_met = sc.last[a as usize] == b && (meta_b.wall || sc.last[b as usize] == a);
             if just_met || sc.stuck.contains(&pair_key(a, b)) {
                 return Ok(()); // the pair was handled; its hook chose to leave them so
             }
