@@ -58,6 +58,11 @@ pub const STRESS: &[Stress] = &[
         error: "worst angle error of the outgoing velocities against the exact 90 degrees (rad)",
         run: glancing,
     },
+    Stress {
+        name: "deep pile (20 rows)",
+        error: "deepest overlap after 2 s, in radii (inf for NaN)",
+        run: deep_pile,
+    },
 ];
 
 const DT: f64 = 1.0 / 60.0;
@@ -170,11 +175,12 @@ fn floor_box(method: Method) -> Result<World<DVec2>, Error> {
     Ok(w)
 }
 
-fn resting_pile(method: Method) -> Result<f64, Error> {
+/// `rows` rows of touching balls resting on the floor of `floor_box` (a hair apart, hexagonal),
+/// restitution 0.5.
+fn pile(method: Method, rows: usize) -> Result<World<DVec2>, Error> {
     let mut w = floor_box(method)?;
-    // Three rows of touching balls resting on the floor (a hair apart), restitution 0.5.
     let r = 0.5;
-    for row in 0..3 {
+    for row in 0..rows {
         for k in 0..9 {
             let x = 0.5 + r + k as f64 * (2.0 * r + 1e-6) + if row % 2 == 1 { r } else { 0.0 };
             if x > 10.0 - r {
@@ -188,6 +194,11 @@ fn resting_pile(method: Method) -> Result<f64, Error> {
             )?;
         }
     }
+    Ok(w)
+}
+
+fn resting_pile(method: Method) -> Result<f64, Error> {
+    let mut w = pile(method, 3)?;
     let e0 = total_energy(&w);
     let scale = w
         .critters()
@@ -208,6 +219,17 @@ fn resting_pile(method: Method) -> Result<f64, Error> {
     }
     Ok(worst)
 }
+
+/// A pile deep enough that the bottom rows carry 20 rows' weight: how far do the balls sink
+/// into each other (the 3-row pile hides this)?
+fn deep_pile(method: Method) -> Result<f64, Error> {
+    let mut w = pile(method, DEEP_PILE_ROWS)?;
+    w.run(120)?;
+    Ok(max_overlap(&w))
+}
+
+/// Rows of the deep pile (about 190 balls).
+pub const DEEP_PILE_ROWS: usize = 20;
 
 fn mass_ratios(method: Method) -> Result<f64, Error> {
     let mut worst: f64 = 0.0;

@@ -287,6 +287,20 @@ fn stress_scenes_meet_their_documented_bounds() {
     assert!((STRESS[4].run)(Method::Discrete).unwrap() > 0.01);
 }
 
+/// The deep pile's row of `docs/stability.md`: the discrete step lets the 20-row pile sink more
+/// than a radius into itself within 2 s; 8 substeps keep it under half a radius.
+#[test]
+fn the_discrete_step_sinks_in_a_deep_pile_and_substeps_reduce_it() {
+    let deep = STRESS
+        .iter()
+        .find(|s| s.name.starts_with("deep pile"))
+        .expect("the deep pile is a stress scene");
+    let discrete = (deep.run)(Method::Discrete).unwrap();
+    let substep = (deep.run)(Method::Substep(8)).unwrap();
+    assert!(discrete > 1.0, "discrete: {discrete}");
+    assert!(substep < 0.5, "substep:8: {substep}");
+}
+
 #[test]
 #[ignore]
 fn print_bullet_sweep() {
