@@ -226,7 +226,7 @@ pub(crate) fn run<V: Vector>(
 ) -> Result<bool, Error> {
     let mut sc = std::mem::take(&mut world.flight);
     let out = run_with(world, &mut sc, acc, t_end, stats);
-    sc.heap.reset(0);
+    sc.heap.reset(0, 0.0, 0.0);
     world.flight = sc;
     out
 }
@@ -350,7 +350,7 @@ fn run_with<V: Vector>(
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     let n = w.critters.slot_count();
-    sc.heap.reset(n);
+    sc.heap.reset(n, 0.0, t_end);
     sc.stuck.clear();
     for v in [&mut sc.count, &mut sc.cell, &mut sc.last] {
         v.clear();

@@ -1,15 +1,20 @@
-//! The event queue of the flight: one pending event per critter, in an indexed binary min-heap.
+//! The event queue of the flight: one pending event per critter, in a calendar of time buckets
+//! in front of an indexed binary min-heap (Paul, J. Comput. Phys. 221, 2007, as used by
+//! event-driven hard-sphere codes).
 //!
-//! A critter's new prediction replaces its old event in place (sifted up or down), so the heap
-//! never holds more than one entry per critter and has no stale entries to pop and skip (lazy
-//! deletion let it grow to several per critter). Entries are ordered by time, then owner: each
-//! owner has one entry, so that order is total and a run repeats bit for bit. The two are packed
-//! into one integer key (the time's bits mapped to an order-keeping integer, then the owner), so
-//! a comparison is one integer comparison.
+//! A critter's new prediction replaces its old event, so the queue never holds more than one
+//! entry per critter and has no stale entries to pop and skip. Events are ordered by time, then
+//! owner: each owner has one entry, so that order is total and a run repeats bit for bit.
+//!
+//! The flight's time span is cut into about one bucket per critter. Only the events of the
+//! buckets up to the current one are in the heap (a few, so a sift is a few levels); later ones
+//! wait in their bucket's list, where adding and removing costs a few pointer writes. A bucket
+//! follows from the time by a monotone formula, so every listed event is later than every event
+//! in the heap, and the order of the pops is exactly the order of (time, owner).
 
 const NONE: u32 = u32::MAX;
-/// Children per node. Measured on the 2D gas: 2 beat 4 (more instructions per level).
-const ARITY: usize = 2;
+/// `Queue::loc` of an owner whose event is in the heap.
+const IN_HEAP: u32 = u32::MAX - 1;
 
 /// What the queue needs of an event: its time and its owner.
 pub(crate) trait Owned: Copy {
@@ -18,20 +23,35 @@ pub(crate) trait Owned: Copy {
 }
 
 pub(crate) struct Queue<E> {
-    /// Keys (`key`: time, then owner), a min-heap: the children of `i` are `ARITY i + 1..`.
-    heap: Vec<u128>,
-    /// Each owner's place in `heap`, or `NONE`.
-    at: Vec<u32>,
-    /// Each owner's event (meaningful while `at` is set).
+    heap: Heap,
+    /// Where each owner's event is: `NONE`, `IN_HEAP`, or the bucket whose list holds it.
+    loc: Vec<u32>,
+    /// The bucket lists: first owner per bucket, then links per owner.
+    first: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    /// Each owner's event (meaningful while `loc` is set).
     events: Vec<Option<E>>,
+    /// Bucket `b` holds the times from `start + b / per_time` on; the last bucket holds the
+    /// rest.
+    start: f64,
+    per_time: f64,
+    /// The heap holds the events of the buckets up to this one.
+    current: usize,
 }
 
 impl<E> Default for Queue<E> {
     fn default() -> Self {
         Self {
-            heap: Vec::new(),
-            at: Vec::new(),
+            heap: Heap::default(),
+            loc: Vec::new(),
+            first: Vec::new(),
+            next: Vec::new(),
+            prev: Vec::new(),
             events: Vec::new(),
+            start: 0.0,
+            per_time: 0.0,
+            current: 0,
         }
     }
 }
@@ -52,54 +72,195 @@ fn owner_of(key: u128) -> u32 {
 }
 
 impl<E: Owned> Queue<E> {
-    /// Empties the queue for owners `0..n`.
-    pub fn reset(&mut self, n: usize) {
-        self.heap.clear();
-        self.at.clear();
-        self.at.resize(n, NONE);
+    /// Empties the queue for owners `0..n` and events between `start` and `end` (later events
+    /// are kept too, in the last bucket).
+    pub fn reset(&mut self, n: usize, start: f64, end: f64) {
+        self.heap.reset(n);
+        self.loc.clear();
+        self.loc.resize(n, NONE);
+        self.next.clear();
+        self.next.resize(n, NONE);
+        self.prev.clear();
+        self.prev.resize(n, NONE);
         self.events.clear();
         self.events.resize_with(n, || None);
+        let span = end - start;
+        let buckets = if span > 0.0 && span.is_finite() && n > 0 {
+            n.next_power_of_two().clamp(64, 1 << 22)
+        } else {
+            0 // no span: everything in the heap
+        };
+        self.first.clear();
+        self.first.resize(buckets + 1, NONE);
+        self.start = start;
+        self.per_time = if buckets > 0 {
+            buckets as f64 / span
+        } else {
+            0.0
+        };
+        self.current = 0;
     }
 
     #[cfg(test)]
     pub fn len(&self) -> usize {
-        self.heap.len()
+        self.loc.iter().filter(|&&l| l != NONE).count()
+    }
+
+    /// The bucket of time `t`: non-decreasing in `t`, so a later bucket means a later time.
+    #[inline]
+    fn bucket(&self, t: f64) -> usize {
+        // `as` saturates (and maps NaN to 0): monotone for every t.
+        let b = ((t - self.start) * self.per_time) as usize;
+        b.min(self.first.len() - 1)
     }
 
     /// Makes `e` its owner's pending event, replacing the one it had.
     pub fn set(&mut self, e: E) {
         let a = e.owner();
-        let entry = key(e.time(), a);
+        let k = key(e.time(), a);
         self.events[a as usize] = Some(e);
-        let i = self.at[a as usize];
-        if i == NONE {
-            self.heap.push(entry);
-            self.sift_up(self.heap.len() - 1);
-        } else {
-            let i = i as usize;
-            let old = self.heap[i];
-            self.heap[i] = entry;
-            if entry < old {
-                self.sift_up(i);
+        let b = self.bucket(e.time());
+        let loc = self.loc[a as usize];
+        if b <= self.current {
+            if loc == IN_HEAP {
+                self.heap.update(k);
             } else {
-                self.sift_down(i);
+                if loc != NONE {
+                    self.unlink(a, loc as usize);
+                }
+                self.heap.push(k);
+                self.loc[a as usize] = IN_HEAP;
             }
+        } else {
+            if loc == IN_HEAP {
+                self.heap.remove(a);
+            } else if loc != NONE {
+                self.unlink(a, loc as usize);
+            }
+            self.link(a, b);
         }
     }
 
     /// Drops owner `a`'s pending event, if it has one.
     pub fn remove(&mut self, a: u32) {
+        match self.loc[a as usize] {
+            NONE => return,
+            IN_HEAP => self.heap.remove(a),
+            b => self.unlink(a, b as usize),
+        }
+        self.loc[a as usize] = NONE;
+        self.events[a as usize] = None;
+    }
+
+    /// The earliest event, left in the queue: a caller that predicts its owner again next
+    /// replaces it in place.
+    #[inline]
+    pub fn peek(&mut self) -> Option<E> {
+        loop {
+            if let Some(k) = self.heap.top() {
+                return self.events[owner_of(k) as usize];
+            }
+            if self.current + 1 >= self.first.len() {
+                return None;
+            }
+            self.current += 1;
+            self.open(self.current);
+        }
+    }
+
+    /// Takes the earliest event out of the queue.
+    #[cfg(test)]
+    pub fn pop(&mut self) -> Option<E> {
+        let e = self.peek()?;
+        self.remove(e.owner());
+        Some(e)
+    }
+
+    /// Moves bucket `b`'s events into the heap.
+    fn open(&mut self, b: usize) {
+        let mut a = self.first[b];
+        self.first[b] = NONE;
+        while a != NONE {
+            let next = self.next[a as usize];
+            let e = self.events[a as usize].expect("a listed owner has an event");
+            self.heap.push(key(e.time(), a));
+            self.loc[a as usize] = IN_HEAP;
+            a = next;
+        }
+    }
+
+    fn link(&mut self, a: u32, b: usize) {
+        let head = self.first[b];
+        self.next[a as usize] = head;
+        self.prev[a as usize] = NONE;
+        if head != NONE {
+            self.prev[head as usize] = a;
+        }
+        self.first[b] = a;
+        self.loc[a as usize] = b as u32;
+    }
+
+    fn unlink(&mut self, a: u32, b: usize) {
+        let (p, n) = (self.prev[a as usize], self.next[a as usize]);
+        if p == NONE {
+            self.first[b] = n;
+        } else {
+            self.next[p as usize] = n;
+        }
+        if n != NONE {
+            self.prev[n as usize] = p;
+        }
+    }
+}
+
+/// An indexed binary min-heap of keys (`key`: time, then owner), at most one per owner.
+#[derive(Default)]
+struct Heap {
+    keys: Vec<u128>,
+    /// Each owner's place in `keys`, or `NONE`.
+    at: Vec<u32>,
+}
+
+impl Heap {
+    fn reset(&mut self, n: usize) {
+        self.keys.clear();
+        self.at.clear();
+        self.at.resize(n, NONE);
+    }
+
+    #[inline]
+    fn top(&self) -> Option<u128> {
+        self.keys.first().copied()
+    }
+
+    fn push(&mut self, k: u128) {
+        self.keys.push(k);
+        self.sift_up(self.keys.len() - 1);
+    }
+
+    /// Replaces the key of `k`'s owner (which has one in the heap) by `k`.
+    fn update(&mut self, k: u128) {
+        let i = self.at[owner_of(k) as usize] as usize;
+        let old = self.keys[i];
+        self.keys[i] = k;
+        if k < old {
+            self.sift_up(i);
+        } else {
+            self.sift_down(i);
+        }
+    }
+
+    fn remove(&mut self, a: u32) {
         let i = self.at[a as usize];
         if i == NONE {
             return;
         }
         self.at[a as usize] = NONE;
-        self.events[a as usize] = None;
-        let last = self.heap.pop().expect("an entry is in the heap");
+        let last = self.keys.pop().expect("an entry is in the heap");
         let i = i as usize;
-        if i < self.heap.len() {
-            self.heap[i] = last;
-            if i > 0 && last < self.heap[(i - 1) / ARITY] {
+        if i < self.keys.len() {
+            self.keys[i] = last;
+            if i > 0 && last < self.keys[(i - 1) / 2] {
                 self.sift_up(i);
             } else {
                 self.sift_down(i);
@@ -107,60 +268,43 @@ impl<E: Owned> Queue<E> {
         }
     }
 
-    /// The earliest event, left in the queue: a caller that predicts its owner again next
-    /// replaces it in place, one sift instead of a removal and an insertion.
-    #[inline]
-    pub fn peek(&self) -> Option<E> {
-        let &k = self.heap.first()?;
-        self.events[owner_of(k) as usize]
-    }
-
-    /// Takes the earliest event out of the queue.
-    #[cfg(test)]
-    pub fn pop(&mut self) -> Option<E> {
-        let a = owner_of(*self.heap.first()?);
-        let e = self.events[a as usize];
-        self.remove(a);
-        e
-    }
-
     fn sift_up(&mut self, mut i: usize) {
-        let entry = self.heap[i];
+        let entry = self.keys[i];
         while i > 0 {
-            let parent = (i - 1) / ARITY;
-            if entry >= self.heap[parent] {
+            let parent = (i - 1) / 2;
+            if entry >= self.keys[parent] {
                 break;
             }
-            self.heap[i] = self.heap[parent];
-            self.at[owner_of(self.heap[i]) as usize] = i as u32;
+            self.keys[i] = self.keys[parent];
+            self.at[owner_of(self.keys[i]) as usize] = i as u32;
             i = parent;
         }
-        self.heap[i] = entry;
+        self.keys[i] = entry;
         self.at[owner_of(entry) as usize] = i as u32;
     }
 
     fn sift_down(&mut self, mut i: usize) {
-        let entry = self.heap[i];
-        let n = self.heap.len();
+        let entry = self.keys[i];
+        let n = self.keys.len();
         loop {
-            let first = ARITY * i + 1;
-            if first >= n {
+            let left = 2 * i + 1;
+            if left >= n {
                 break;
             }
-            let mut child = first;
-            for c in first + 1..(first + ARITY).min(n) {
-                if self.heap[c] < self.heap[child] {
-                    child = c;
-                }
-            }
-            if self.heap[child] >= entry {
+            let right = left + 1;
+            let child = if right < n && self.keys[right] < self.keys[left] {
+                right
+            } else {
+                left
+            };
+            if self.keys[child] >= entry {
                 break;
             }
-            self.heap[i] = self.heap[child];
-            self.at[owner_of(self.heap[i]) as usize] = i as u32;
+            self.keys[i] = self.keys[child];
+            self.at[owner_of(self.keys[i]) as usize] = i as u32;
             i = child;
         }
-        self.heap[i] = entry;
+        self.keys[i] = entry;
         self.at[owner_of(entry) as usize] = i as u32;
     }
 }
@@ -212,46 +356,53 @@ mod tests {
     }
 
     /// The queue against a plain model (a map from owner to event; the earliest found by a
-    /// scan) under random sets, removes and pops, with many equal times so ties are tested.
+    /// scan) under random sets, removes and pops, as the flight uses it: new events are never
+    /// earlier than the last one popped. Many equal times, so ties are tested, and times past
+    /// the calendar's end and exactly on bucket edges.
     #[test]
     fn the_queue_pops_what_a_scan_of_the_pending_events_finds_first() {
         let mut rng = Rng::new(7);
         let mut below = |k: u64| (rng.next_u64() % k) as u32;
         let n = 50u32;
-        let mut q = Queue::<E>::default();
-        q.reset(n as usize);
-        let mut model: BTreeMap<u32, E> = BTreeMap::new();
-        let mut pops = 0;
-        for tag in 0..20_000u64 {
-            match below(10) {
-                0..=5 => {
-                    let e = E {
-                        t: f64::from(below(40)) * 0.25,
-                        a: below(u64::from(n)),
-                        tag,
-                    };
-                    q.set(e);
-                    model.insert(e.a, e);
-                }
-                6 => {
-                    let a = below(u64::from(n));
-                    q.remove(a);
-                    model.remove(&a);
-                }
-                _ => {
-                    let want = model
-                        .values()
-                        .min_by(|x, y| x.t.total_cmp(&y.t).then(x.a.cmp(&y.a)))
-                        .copied();
-                    if let Some(w) = want {
-                        model.remove(&w.a);
-                        pops += 1;
+        for (start, end) in [(0.0, 10.0), (2.0, 3.0), (0.0, 0.0), (1.0, f64::INFINITY)] {
+            let mut q = Queue::<E>::default();
+            q.reset(n as usize, start, end);
+            let mut model: BTreeMap<u32, E> = BTreeMap::new();
+            let mut now = start;
+            let mut pops = 0;
+            for tag in 0..20_000u64 {
+                match below(10) {
+                    0..=5 => {
+                        // From now to a little past the end, in steps of a 64th of the span.
+                        let e = E {
+                            t: now + f64::from(below(80)) * 0.125,
+                            a: below(u64::from(n)),
+                            tag,
+                        };
+                        q.set(e);
+                        model.insert(e.a, e);
                     }
-                    assert_eq!(q.pop(), want);
+                    6 => {
+                        let a = below(u64::from(n));
+                        q.remove(a);
+                        model.remove(&a);
+                    }
+                    _ => {
+                        let want = model
+                            .values()
+                            .min_by(|x, y| x.t.total_cmp(&y.t).then(x.a.cmp(&y.a)))
+                            .copied();
+                        if let Some(w) = want {
+                            model.remove(&w.a);
+                            now = w.t;
+                            pops += 1;
+                        }
+                        assert_eq!(q.pop(), want, "span {start}..{end}");
+                    }
                 }
+                assert_eq!(q.len(), model.len());
             }
-            assert_eq!(q.len(), model.len());
+            assert!(pops > 1000, "the test popped only {pops} events");
         }
-        assert!(pops > 1000, "the test popped only {pops} events");
     }
 }
