@@ -700,7 +700,7 @@ fn finish_prediction<V: Vector>(
         }
     }
     sc.best[a as usize] = sc.cand;
-    predict_border(w, sc, a, t);
+    predict_border(w, sc, a, t, mine);
     if sc.straight {
         predict_cell_straight(w, sc, a, t, mine);
     } else {
@@ -1001,13 +1001,13 @@ fn advance_to_contact(gap: impl Fn(f64) -> f64, speed: f64, horizon: f64, scale:
     Advance::Continue(s)
 }
 
-fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+/// Border hits of disk `a` (`mine`: its position, velocity and acceleration at `t`).
+fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64, mine: (V, V, V)) {
     if w.topo.border == Border::Wrap {
         return;
     }
-    let c = w.critters.slot(a).expect("live slot");
-    let r = c.radius;
-    let (p, v, acc) = state_at(sc, a, t);
+    let r = sc.body[a as usize].radius;
+    let (p, v, acc) = mine;
     let just = sc.last[a as usize];
     for axis in 0..V::DIM {
         let lo = w.topo.min.get(axis) + r;
