@@ -4,10 +4,12 @@
 //! Events: pair collisions, wall hits, border hits (bounce and clamp borders) and cell crossings
 //! (Rapaport, J. Comput. Phys. 34, 1980): the world box is cut into cells at least one diameter
 //! wide, a critter predicts collisions only with critters in its own and the neighbouring cells,
-//! and crossing into a new cell is an event that predicts against the new neighbours. Each
-//! critter keeps its own clock (it is advanced only when it takes part in an event) and an event
-//! counter; an event stores its critters' counters when predicted and is stale once either has
-//! changed (lazy invalidation in one binary heap). Ties are broken by time, then ids, then kind.
+//! and crossing into a new cell is an event that predicts against the new neighbours (keeping
+//! the critter's best pair event for the old ones). Each critter keeps its own clock (it is
+//! advanced only when it takes part in an event) and an event counter; an event stores its
+//! critters' counters when predicted, and a partner's changed counter sends the owner to predict
+//! again. Each critter has one pending event, in the queue of `crate::method::queue`, which
+//! orders by time, then owner; a critter's candidates are ordered by time, then ids, then kind.
 //!
 //! Finite precision (Bannerman et al., arXiv:1211.6718): collisions are predicted for a contact
 //! distance a hair (`SKIN`, relative) inside the true one, so at the predicted time the pair
