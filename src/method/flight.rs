@@ -669,18 +669,14 @@ fn predict_all<V: Vector>(
     sc.predictions += 1;
     let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
-    let dims = sc.dims;
-    let hc = sc.coord[a as usize];
-    let interior = !sc.offsets.is_empty()
-        && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= dims[ax] as i64);
-    if interior {
+    if interior::<V>(sc, a) {
         // The common case: the neighbours are fixed offsets away, no wrapping, no repeats.
         for i in 0..sc.offsets.len() {
             let k = (home as isize + sc.offsets[i]) as usize;
             scan_cell(w, sc, a, k, t, mine)?;
         }
     } else {
-        scan_edge_neighbours(w, sc, a, home, t, mine)?;
+        scan_edge_neighbours(w, sc, a, t, mine)?;
     }
     finish_prediction(w, sc, a, home, t, mine)
 }
@@ -728,12 +724,9 @@ fn predict_after_crossing<V: Vector>(
     t: f64,
 ) -> Result<(), Error> {
     let home = sc.cell[a as usize] as usize;
-    let hc = sc.coord[a as usize];
     let kept = sc.best[a as usize];
     let kept_valid = kept.is_none_or(|ev| matches!(validity(sc, &ev), Validity::Valid));
-    let interior = !sc.offsets.is_empty()
-        && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= sc.dims[ax] as i64);
-    if !(sc.straight && kept_valid && interior && sc.meta[a as usize].alive) {
+    if !(sc.straight && kept_valid && interior::<V>(sc, a) && sc.meta[a as usize].alive) {
         return predict_all(w, sc, a, t);
     }
     sc.predictions += 1;
@@ -751,6 +744,14 @@ fn predict_after_crossing<V: Vector>(
     sc.front[tag as usize] = front;
     out?;
     finish_prediction(w, sc, a, home, t, mine)
+}
+
+/// Whether `a`'s cell is off the grid's edges, so its neighbours are `offsets` away (no
+/// wrapping, no repeats).
+#[inline]
+fn interior<V: Vector>(sc: &Scratch<V>, a: u32) -> bool {
+    let hc = sc.coord[a as usize];
+    !sc.offsets.is_empty() && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= sc.dims[ax] as i64)
 }
 
 /// Predicts `a` against the disks of cell `k`.
@@ -807,18 +808,17 @@ fn predict_disk<V: Vector>(
     offer_pair(w, sc, a, b, t, s, PAIR)
 }
 
-/// Predicts `a`, in cell `home` at the edge of the grid, against the disks of the cells around
+/// Predicts `a`, in a cell at the edge of the grid, against the disks of the cells around
 /// it: wrapped or cut at the border, each cell once.
 fn scan_edge_neighbours<V: Vector>(
     w: &mut World<V>,
     sc: &mut Scratch<V>,
     a: u32,
-    home: usize,
     t: f64,
     mine: (V, V, V),
 ) -> Result<(), Error> {
     let dims = sc.dims;
-    let hc = coords(&dims, home);
+    let hc = sc.coord[a as usize];
     let small = dims[..V::DIM].iter().any(|&n| n < 3);
     let mut seen = [usize::MAX; 27];
     let mut nseen = 0;
@@ -948,31 +948,29 @@ fn offer_pair<V: Vector>(
     s: f64,
     kind: u8,
 ) -> Result<(), Error> {
-    {
-        let (meta_a, meta_b) = (sc.meta[a as usize], sc.meta[b as usize]);
-        let rule = match w.rules.cached(meta_a.class, meta_b.class) {
-            Some(rule) => rule,
-            None => {
-                let (ca, cb) = (
-                    w.critters.slot(a).expect("live"),
-                    w.critters.slot(b).expect("live"),
-                );
-                w.rules
-                    .rule(&w.kinds, &w.topo, ca, cb)
-                    .map_err(|e| at_step(e, w.step_count))?
-            }
-        };
-        if rule == Some(PairRule::DontCollide) {
-            return Ok(());
+    let (meta_a, meta_b) = (sc.meta[a as usize], sc.meta[b as usize]);
+    let rule = match w.rules.cached(meta_a.class, meta_b.class) {
+        Some(rule) => rule,
+        None => {
+            let (ca, cb) = (
+                w.critters.slot(a).expect("live"),
+                w.critters.slot(b).expect("live"),
+            );
+            w.rules
+                .rule(&w.kinds, &w.topo, ca, cb)
+                .map_err(|e| at_step(e, w.step_count))?
         }
-        if s == 0.0 {
-            let just_met = sc.last[a as usize] == b && (meta_b.wall || sc.last[b as usize] == a);
-            if just_met || sc.stuck.contains(&pair_key(a, b)) {
-                return Ok(()); // the pair was handled; its hook chose to leave them so
-            }
-        }
-        push(sc, t + s, a, b, kind);
+    };
+    if rule == Some(PairRule::DontCollide) {
+        return Ok(());
     }
+    if s == 0.0 {
+        let just_met = sc.last[a as usize] == b && (meta_b.wall || sc.last[b as usize] == a);
+        if just_met || sc.stuck.contains(&pair_key(a, b)) {
+            return Ok(()); // the pair was handled; its hook chose to leave them so
+        }
+    }
+    push(sc, t + s, a, b, kind);
     Ok(())
 }
 
