@@ -38,6 +38,7 @@ pub const PRIORITY_NAMES: [(&str, f64); 7] = [
 /// When a critter dies its slot may be reused, but with the next generation, so the id of a dead
 /// critter never names a new one. Ids order by index, then generation.
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[repr(C)]
 pub struct CritterId {
     /// Slot index in the world's critter set.
     pub index: u32,

@@ -1,13 +1,11 @@
-//! The per-step state hash: a fast 64-bit hash over raw float bits, so a replay can check itself.
+//! A fast 64-bit hash over raw words, so a replay can check itself.
 //!
-//! Recording hashes every step, so the hash must cost little next to a step: eight independent
-//! multiply-xor lanes take eight words at a time (two critters of four words each), so the
-//! multiplies overlap instead of waiting on each other, and the lanes are combined at the end.
-//! A critter's fields are folded into four words with [`pair`] and [`quad`] (fields XORed at
-//! distinct rotations), which halves the multiplies of one word per field pair; any one field
-//! changing alone still changes its word. Each lane update
+//! Eight independent multiply-xor lanes take eight words at a time, so the multiplies overlap
+//! instead of waiting on each other, and the lanes are combined at the end. Each lane update
 //! `(h.rotate_left(5) ^ w) * K` is a bijection of `h` for a fixed `w` and of `w` for a fixed `h`,
-//! so a change in any one word always changes that lane's state.
+//! so a change in any one word always changes that lane's state. The critters' fields, the bulk
+//! of a world's state, have a pass of their own with the same update (`src/critter_hash.rs`);
+//! this hasher takes the world's few other words and that pass's lanes.
 
 /// The odd multiplier of every lane.
 const K: u64 = 0x5851_F42D_4C95_7F2D;
@@ -72,19 +70,6 @@ impl StateHasher {
     }
 }
 
-/// Two floats' bits in one word: `a ^ rotl(b, 32)` changes whenever either changes alone.
-#[inline]
-pub fn pair(a: f64, b: f64) -> u64 {
-    a.to_bits() ^ b.to_bits().rotate_left(32)
-}
-
-/// Four floats' bits in one word, each at its own rotation (0, 32, 16, 48 bits): the word
-/// changes whenever any one of them changes alone.
-#[inline]
-pub fn quad(a: f64, b: f64, c: f64, d: f64) -> u64 {
-    pair(a, b) ^ pair(c, d).rotate_left(16)
-}
-
 #[inline]
 fn mix(h: u64, w: u64) -> u64 {
     (h.rotate_left(5) ^ w).wrapping_mul(K)
@@ -123,29 +108,6 @@ mod tests {
                 let mut w = base;
                 w[lane] ^= 1 << bit;
                 assert_ne!(hash(w), h0, "lane {lane} bit {bit}");
-            }
-        }
-        // Either half of a pair alone changes the pair.
-        assert_ne!(
-            pair(1.0, 2.0),
-            pair(1.0, f64::from_bits(2.0f64.to_bits() ^ 1))
-        );
-        assert_ne!(
-            pair(1.0, 2.0),
-            pair(f64::from_bits(1.0f64.to_bits() ^ 1), 2.0)
-        );
-    }
-
-    #[test]
-    fn any_one_of_four_floats_changes_its_word_at_every_bit() {
-        let base = [1.5f64, -2.25, 3.0e-7, 4.0e9];
-        let word = |x: [f64; 4]| quad(x[0], x[1], x[2], x[3]);
-        let w0 = word(base);
-        for i in 0..4 {
-            for bit in 0..64 {
-                let mut x = base;
-                x[i] = f64::from_bits(x[i].to_bits() ^ (1 << bit));
-                assert_ne!(word(x), w0, "float {i} bit {bit}");
             }
         }
     }

@@ -28,6 +28,7 @@ pub mod cli;
 pub mod contact;
 pub mod context;
 pub mod critter;
+pub mod critter_hash;
 pub mod critter_set;
 pub mod error;
 pub mod hash;

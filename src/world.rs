@@ -20,11 +20,11 @@ use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode};
 use crate::contact::contact_wall_ball;
 use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
 use crate::critter::{
-    check_positive, Critter, CritterId, CritterSpec, PropValue, Shape, CLASS_UNSET, CP_WALL,
+    check_positive, Critter, CritterId, CritterSpec, Shape, CLASS_UNSET, CP_WALL,
 };
 use crate::critter_set::CritterSet;
 use crate::error::Error;
-use crate::hash::{quad, StateHasher};
+use crate::hash::{StateHasher, LANES};
 use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
 use crate::method::Method;
 use crate::rng::Rng;
@@ -439,9 +439,13 @@ impl<V: Vector> World<V> {
         &self.rules
     }
 
-    /// Total kinetic energy of the free critters.
+    /// Total kinetic energy of the free critters, summed in slot order.
     pub fn kinetic_energy(&self) -> f64 {
-        self.critters.iter().map(Critter::kinetic_energy).sum()
+        let mut e = 0.0;
+        for c in self.critters.iter() {
+            e += c.kinetic_energy();
+        }
+        e
     }
     /// Total momentum of the free critters.
     pub fn momentum(&self) -> V {
@@ -477,44 +481,29 @@ impl<V: Vector> World<V> {
     /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
     /// radius, mass, priority, restitution, health and properties.
     pub fn state_hash(&self) -> u64 {
-        self.state_hash_visiting(|_| {})
+        self.state_hash_and_totals().0
     }
 
-    /// [`World::state_hash`], calling `visit` on each critter (in slot order) in the same pass,
-    /// so a recorder can sum its totals without walking the critters a second time.
-    pub fn state_hash_visiting(&self, mut visit: impl FnMut(&Critter<V>)) -> u64 {
+    /// [`World::state_hash`], [`World::kinetic_energy`] and [`World::momentum`] (the same bits)
+    /// from one pass over the critters, so a recorder walks them once.
+    pub fn state_hash_and_totals(&self) -> (u64, f64, V) {
         let mut h = StateHasher::default();
         h.word(self.step_count);
         h.float(self.dt);
         for w in self.rng.state() {
             h.word(w);
         }
-        // Two words per critter, four critters per eight-lane update, so the lanes' multiplies
-        // overlap and there are few of them (see src/hash.rs). Properties go to a hasher of
-        // their own (after the owner's id), so the main lanes stay in registers.
+        // Every critter's fields in sixteen lanes (src/critter_hash.rs); properties go to a
+        // hasher of their own, after their owner's id.
         let mut props = StateHasher::default();
-        let mut buf = [0u64; 8];
-        let mut filled = 0;
-        for c in self.critters.iter() {
-            visit(c);
-            let [a, b] = critter_words(c);
-            buf[filled] = a;
-            buf[filled + 1] = b;
-            filled += 2;
-            if filled == 8 {
-                h.words(buf);
-                filled = 0;
-            }
-            if !c.props.is_empty() {
-                hash_props(&mut props, c);
-            }
-        }
-        if filled > 0 {
-            buf[filled..].fill(0);
-            h.words(buf);
+        let pass = crate::critter_hash::pass(self.critters.slot_slice(), &mut props);
+        for half in pass.lanes.chunks_exact(LANES) {
+            let mut w = [0u64; LANES];
+            w.copy_from_slice(half);
+            h.words(w);
         }
         h.word(props.finish());
-        h.finish()
+        (h.finish(), pass.energy, pass.momentum)
     }
 
     // ----- building ---------------------------------------------------------------------------
@@ -1183,70 +1172,6 @@ fn hook_error<V: Vector>(
             step,
             message: other.to_string(),
         },
-    }
-}
-
-/// A critter's hashed fields in two words. Each word is the XOR of independent fields at
-/// distinct rotations (see [`crate::hash::quad`]), so a change to any one field always changes
-/// its word: id, flags (kind, fixed, alive, number of properties), position and velocity in the
-/// first; radius, mass, priority, restitution, health and the z components (3D) in the second.
-#[inline]
-fn critter_words<V: Vector>(c: &Critter<V>) -> [u64; 2] {
-    let id = ((c.id.index as u64) << 32) | c.id.generation as u64;
-    let flags = ((c.kind.0 as u64) << 2)
-        | ((c.fixed as u64) << 1)
-        | c.alive as u64
-        | ((c.props.len() as u64) << 40);
-    let (z, vz) = if V::DIM == 3 {
-        (c.pos.get(2), c.vel.get(2))
-    } else {
-        (0.0, 0.0)
-    };
-    [
-        id ^ flags.rotate_left(16)
-            ^ quad(c.pos.get(0), c.pos.get(1), c.vel.get(0), c.vel.get(1)).rotate_left(8),
-        quad(c.radius, c.mass, c.priority, c.restitution)
-            ^ quad(c.health, z, vz, 0.0).rotate_left(8),
-    ]
-}
-
-/// A critter's properties (names and values), after its id.
-#[inline(never)]
-fn hash_props<V: Vector>(h: &mut StateHasher, c: &Critter<V>) {
-    h.word(((c.id.index as u64) << 32) | c.id.generation as u64);
-    for (name, value) in &c.props {
-        hash_bytes(h, name.as_bytes());
-        hash_prop(h, value);
-    }
-}
-
-fn hash_prop(h: &mut StateHasher, value: &PropValue) {
-    match value {
-        PropValue::Bool(b) => h.word(*b as u64),
-        PropValue::Int(i) => h.word(*i as u64),
-        PropValue::Float(x) => h.float(*x),
-        PropValue::Text(s) => hash_bytes(h, s.as_bytes()),
-        PropValue::Critter(id) => h.word(((id.index as u64) << 32) | id.generation as u64),
-        PropValue::Vector(v) => {
-            for x in v {
-                h.float(*x);
-            }
-        }
-        PropValue::List(items) => {
-            h.word(items.len() as u64);
-            for item in items {
-                hash_prop(h, item);
-            }
-        }
-    }
-}
-
-fn hash_bytes(h: &mut StateHasher, bytes: &[u8]) {
-    h.word(bytes.len() as u64);
-    for chunk in bytes.chunks(8) {
-        let mut w = [0u8; 8];
-        w[..chunk.len()].copy_from_slice(chunk);
-        h.word(u64::from_le_bytes(w));
     }
 }
 

@@ -59,15 +59,7 @@ pub fn kind_table<V: Vector>(world: &World<V>) -> KindTable {
 
 /// Hash and totals in one pass over the critters.
 pub fn hash_and_totals<V: Vector>(world: &World<V>) -> (u64, TotalsMsg) {
-    let mut energy = 0.0;
-    let mut momentum = V::zero();
-    let hash = world.state_hash_visiting(|c| {
-        // The same sums, in the same order, as World::kinetic_energy and World::momentum.
-        energy += c.kinetic_energy();
-        if !c.is_fixed() {
-            momentum += c.vel * c.mass();
-        }
-    });
+    let (hash, energy, momentum) = world.state_hash_and_totals();
     let stats = world.stats();
     let totals = TotalsMsg {
         step: world.step_count(),
@@ -152,12 +144,21 @@ pub fn events<V: Vector>(
     let ev = world.events();
     let (step, time) = (world.step_count(), Float(world.time()));
     let collisions = (!ev.collisions.is_empty()).then(|| {
+        // Columns sized once: this runs on the simulation thread every step.
+        let n = ev.collisions.len();
+        let col = || Floats(Vec::with_capacity(n));
         let mut m = CollisionsMsg {
             step,
             time,
-            pz: (V::DIM == 3).then(Floats::default),
-            nz: (V::DIM == 3).then(Floats::default),
-            ..CollisionsMsg::default()
+            caller: Vec::with_capacity(n),
+            arg: Vec::with_capacity(n),
+            px: col(),
+            py: col(),
+            pz: (V::DIM == 3).then(col),
+            nx: col(),
+            ny: col(),
+            nz: (V::DIM == 3).then(col),
+            impulse: col(),
         };
         for e in &ev.collisions {
             m.caller.push(id_key(e.caller));

@@ -180,7 +180,7 @@ impl Recorder {
 
     /// Records the step just taken: hash, totals and events, and the full state on keyframes.
     pub fn record(&mut self, world: &AnyWorld) -> Result<(), RecordError> {
-        let full = world.step_count() % self.every == 0;
+        let full = world.step_count().is_multiple_of(self.every);
         self.capture(world, full)
     }
 
