@@ -176,6 +176,35 @@ fn verify_passes_on_a_clean_file_and_names_a_one_bit_change() {
 }
 
 #[test]
+fn hashes_made_by_another_state_hash_are_refused_with_what_to_do() {
+    let dir = tmp("hash-version");
+    let path = dir.join("billiards.mcap");
+    record(
+        &path,
+        &["billiards", "--steps", "30", "--record-every", "10"],
+    );
+    let mut rec = Recording::open(&path).expect("opens");
+    assert_eq!(
+        rec.meta_map.get("state_hash").map(String::as_str),
+        Some(schema::STATE_HASH)
+    );
+    assert!(verify(&rec, |_| {}).is_ok());
+    // A file from before the key existed (or from another state hash) is refused, not reported
+    // as a replay that diverged at step 0.
+    for old in [None, Some("1")] {
+        match old {
+            None => rec.meta_map.remove("state_hash"),
+            Some(v) => rec.meta_map.insert("state_hash".into(), v.into()),
+        };
+        let err = format!("{:#}", verify(&rec, |_| {}).expect_err("must refuse"));
+        assert!(err.contains("state hash version 1"), "{err}");
+        assert!(err.contains("record the run again"), "{err}");
+        let err = format!("{:#}", state_at_step(&rec, 15).expect_err("must refuse"));
+        assert!(err.contains("state hash version 1"), "{err}");
+    }
+}
+
+#[test]
 fn record_every_k_still_shows_an_unrecorded_step_exactly() {
     let dir = tmp("every_k");
     let (all, sparse) = (dir.join("every1.mcap"), dir.join("every10.mcap"));

@@ -3,7 +3,7 @@
 //! MCAP metadata maps strings to strings; structured values are JSON text, floats are written
 //! in their shortest round-trip form so they read back bit for bit.
 
-use super::schema::FORMAT;
+use super::schema::{FORMAT, STATE_HASH};
 use crate::script::Limits;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -86,6 +86,7 @@ impl RunMeta {
             m.insert(k.to_string(), v);
         };
         put("format", FORMAT.into());
+        put("state_hash", STATE_HASH.into());
         put("critterbox_version", self.version.clone());
         put("scene", self.scene.clone());
         match &self.source {

@@ -293,6 +293,21 @@ pub struct Recording {
 }
 
 impl Recording {
+    /// An error, saying what to do, if the file's state hashes were computed by another state
+    /// hash than this critterbox's (then no recorded hash can match a replayed one).
+    pub fn check_state_hash(&self) -> anyhow::Result<()> {
+        let theirs = self.meta_map.get("state_hash").map_or("1", String::as_str);
+        anyhow::ensure!(
+            theirs == super::schema::STATE_HASH,
+            "{}: its state hashes were computed by state hash version {theirs}, and this \
+             critterbox computes version {} (critterbox changed how it hashes a state on \
+             2026-12-01), so they cannot be checked; record the run again with this critterbox",
+            self.path.display(),
+            super::schema::STATE_HASH
+        );
+        Ok(())
+    }
+
     /// Reads a recording; a file that is not one is a clear error.
     pub fn open(path: &Path) -> anyhow::Result<Recording> {
         let mut rec = Recording {

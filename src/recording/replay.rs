@@ -268,6 +268,7 @@ pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, St
 
 /// The recorded hash of the world's step, if there is one, equals the world's.
 fn check_hash(rec: &Recording, world: &AnyWorld, target: u64) -> anyhow::Result<()> {
+    rec.check_state_hash()?;
     let s = world.step_count();
     if let Some(&h) = rec.hashes.get(&s) {
         let got = world.state_hash();

@@ -39,6 +39,10 @@ pub const END: &str = "critterbox.end";
 pub const RECOVERED: &str = "critterbox.recovered";
 /// Value of the `format` metadata key.
 pub const FORMAT: &str = "critterbox-recording/1";
+/// Value of the `state_hash` metadata key: which state hash the file's hashes were computed
+/// with. 2 since 2026-12-01 (sixteen lanes per critter, `src/critter_hash.rs`); files without
+/// the key used an earlier one.
+pub const STATE_HASH: &str = "2";
 /// Media type of the script attachments.
 pub const SCRIPT_MEDIA_TYPE: &str = "text/x-rhai";
 

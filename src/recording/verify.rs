@@ -52,6 +52,7 @@ struct StepOnly {
 
 /// Re-simulates `rec` and compares everything it recorded. `progress` gets the step reached.
 pub fn verify(rec: &Recording, mut progress: impl FnMut(u64)) -> anyhow::Result<VerifyReport> {
+    rec.check_state_hash()?;
     let mut replay = Replay::new(rec)?;
     let mut report = VerifyReport {
         truncated: rec.truncated.clone(),

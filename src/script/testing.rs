@@ -424,6 +424,9 @@ fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
         |e| fail(format!("cannot read the golden recording {path}: {e:#} (make it with `critterbox test --bless`)")),
         Ok,
     )?;
+    if let Err(e) = golden.check_state_hash() {
+        return fail(format!("{e:#}: rerun with --bless"));
+    }
     let Some(&last) = golden.hashes.keys().next_back() else {
         return fail(format!("the golden recording {path} holds no steps"));
     };
