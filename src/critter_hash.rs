@@ -311,6 +311,16 @@ mod tests {
         (p.lanes.to_vec(), p.energy.to_bits(), momentum)
     }
 
+    fn flip(x: &mut f64, bit: u32) {
+        *x = f64::from_bits(x.to_bits() ^ 1 << bit);
+    }
+
+    fn flip_axis<V: Vector>(v: &mut V, axis: usize, bit: u32) {
+        let mut x = v.get(axis);
+        flip(&mut x, bit);
+        v.set(axis, x);
+    }
+
     /// Every bit of every hashed field of one critter (a disk and a wall, in turn), flipped
     /// alone, changes the world's hash, and both passes agree on every one of those worlds.
     fn every_bit_counts<V: Vector>(mut w: World<V>) {
@@ -331,46 +341,34 @@ mod tests {
             .find(|c| c.is_wall())
             .expect("a wall")
             .id;
-        type Flip<V> = fn(&mut Critter<V>, u32);
-        // One closure per field, each flipping bit `b` of its field.
-        let fields: Vec<(&str, u32, Flip<V>)> = vec![
-            ("pos.x", 64, |c, b| {
-                c.pos
-                    .set(0, f64::from_bits(c.pos.get(0).to_bits() ^ 1 << b))
-            }),
-            ("pos.y", 64, |c, b| {
-                c.pos
-                    .set(1, f64::from_bits(c.pos.get(1).to_bits() ^ 1 << b))
-            }),
-            ("pos.last", 64, |c, b| {
-                let a = V::DIM - 1;
-                c.pos
-                    .set(a, f64::from_bits(c.pos.get(a).to_bits() ^ 1 << b))
-            }),
-            ("vel.x", 64, |c, b| {
-                c.vel
-                    .set(0, f64::from_bits(c.vel.get(0).to_bits() ^ 1 << b))
-            }),
-            ("vel.last", 64, |c, b| {
-                let a = V::DIM - 1;
-                c.vel
-                    .set(a, f64::from_bits(c.vel.get(a).to_bits() ^ 1 << b))
-            }),
-            ("radius", 64, |c, b| {
-                c.radius = f64::from_bits(c.radius.to_bits() ^ 1 << b)
-            }),
-            ("mass", 64, |c, b| {
-                c.mass = f64::from_bits(c.mass.to_bits() ^ 1 << b)
-            }),
-            ("priority", 64, |c, b| {
-                c.priority = f64::from_bits(c.priority.to_bits() ^ 1 << b)
-            }),
-            ("restitution", 64, |c, b| {
-                c.restitution = f64::from_bits(c.restitution.to_bits() ^ 1 << b)
-            }),
-            ("health", 64, |c, b| {
-                c.health = f64::from_bits(c.health.to_bits() ^ 1 << b)
-            }),
+        type Flip<V> = Box<dyn Fn(&mut Critter<V>, u32)>;
+        type Float<V> = fn(&mut Critter<V>) -> &mut f64;
+        type Other<V> = fn(&mut Critter<V>, u32);
+        // Each entry flips bit `b` of one field.
+        let mut fields: Vec<(String, u32, Flip<V>)> = Vec::new();
+        for axis in 0..V::DIM {
+            fields.push((
+                format!("pos[{axis}]"),
+                64,
+                Box::new(move |c, b| flip_axis(&mut c.pos, axis, b)),
+            ));
+            fields.push((
+                format!("vel[{axis}]"),
+                64,
+                Box::new(move |c, b| flip_axis(&mut c.vel, axis, b)),
+            ));
+        }
+        let floats: [(&str, Float<V>); 5] = [
+            ("radius", |c| &mut c.radius),
+            ("mass", |c| &mut c.mass),
+            ("priority", |c| &mut c.priority),
+            ("restitution", |c| &mut c.restitution),
+            ("health", |c| &mut c.health),
+        ];
+        for (name, field) in floats {
+            fields.push((name.into(), 64, Box::new(move |c, b| flip(field(c), b))));
+        }
+        let others: [(&str, u32, Other<V>); 6] = [
             ("id.index", 32, |c, b| c.id.index ^= 1 << b),
             ("id.generation", 32, |c, b| c.id.generation ^= 1 << b),
             ("kind", 32, |c, b| c.kind.0 ^= 1 << b),
@@ -380,6 +378,9 @@ mod tests {
                 c.props.insert("tag".into(), PropValue::Int(1));
             }),
         ];
+        for (name, width, f) in others {
+            fields.push((name.into(), width, Box::new(f)));
+        }
         for who in [disk, wall] {
             for (field, width, flip) in &fields {
                 for bit in 0..*width {
