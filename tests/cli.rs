@@ -77,7 +77,16 @@ fn every_scene_runs_from_the_command_line() {
             stdout(&o).contains("broad phase"),
             "--stats prints stage times"
         );
+        // Runs record by default, so the recording's own time is there too.
+        assert!(
+            stdout(&o).contains("  record       "),
+            "--stats prints the recording's time: {}",
+            stdout(&o)
+        );
     }
+    let o = critterbox(&["run", "gas", "--steps", "5", "--stats", "--no-record"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stdout(&o).contains("  record       "), "nothing recorded");
 }
 
 #[test]

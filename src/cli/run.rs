@@ -105,6 +105,8 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
+    // Time the simulation thread spends recording (hash, totals, events, handing them over).
+    let mut recording = Duration::ZERO;
     for i in 0..steps {
         if record::interrupted() {
             interrupted = true;
@@ -132,7 +134,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             }
         };
         if let Some(r) = &mut recorder {
+            let clock = Instant::now();
             r.record(&scene)?;
+            recording += clock.elapsed();
         }
         if let Some(reason) = outcome {
             stopped = Some((scene.world.step_count(), reason));
@@ -177,7 +181,12 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
     if args.stats {
-        stats(out, &scene.world, done)?;
+        stats(
+            out,
+            &scene.world,
+            done,
+            recorder.is_some().then_some(recording),
+        )?;
     }
     let (outcome, reason) = match (&stopped, interrupted) {
         (_, true) => ("interrupted", "Ctrl-C".to_string()),
@@ -323,7 +332,14 @@ fn summary(
     Ok(())
 }
 
-fn stats(out: &mut dyn Write, world: &AnyWorld, steps: u64) -> anyhow::Result<()> {
+/// Time per stage and pair counts per step; `recording` is the simulation thread's time spent
+/// recording, if the run was recorded.
+fn stats(
+    out: &mut dyn Write,
+    world: &AnyWorld,
+    steps: u64,
+    recording: Option<Duration>,
+) -> anyhow::Result<()> {
     let t = world.totals();
     let per = |d: Duration| d.as_secs_f64() * 1e3 / steps.max(1) as f64;
     let n = steps.max(1) as f64;
@@ -339,6 +355,14 @@ fn stats(out: &mut dyn Write, world: &AnyWorld, steps: u64) -> anyhow::Result<()
         ("total", t.total()),
     ] {
         writeln!(out, "  {stage:<12} {:.4}", per(d))?;
+    }
+    if let Some(r) = recording {
+        writeln!(
+            out,
+            "  record       {:.4} (not in the total: {:.1}% on top of it, on the simulation thread)",
+            per(r),
+            100.0 * r.as_secs_f64() / t.total().as_secs_f64().max(1e-12)
+        )?;
     }
     let rebuilds = world.broad_phase_rebuilds();
     if rebuilds > 0 {
