@@ -95,26 +95,35 @@ impl<V: Vector> Topology<V> {
     /// into the box. Clamp stops the disk at the edge.
     #[inline]
     pub fn apply(&self, pos: V, vel: V, r: f64, e: f64) -> (V, V) {
-        // Most critters are clear of every edge: one branch-free test over the axes, with the
-        // same comparisons the edge code makes, so it passes exactly when that code would
-        // change nothing (and fails on NaN, which the edge code then sees as before).
-        let mut clear = true;
-        for axis in 0..V::DIM {
-            let (lo, hi, x) = (self.min.get(axis), self.max.get(axis), pos.get(axis));
-            clear &= match self.border {
-                Border::Wrap => x >= lo && x < hi,
-                Border::Bounce | Border::Clamp => x >= lo + r && x <= hi - r,
-            };
-        }
-        if clear {
+        if self.clear_of_edges(pos, r) {
             return (pos, vel);
         }
         self.apply_at_edges(pos, vel, r, e)
     }
 
+    /// True when a disk of radius `r` at `pos` is clear of every edge, so that
+    /// [`Topology::apply`] would change nothing.
+    ///
+    /// Most critters are: one branch-free test over the axes, with the same comparisons the
+    /// edge code makes, so it passes exactly when that code would change nothing (and fails on
+    /// NaN, which the edge code then sees as before).
+    #[inline]
+    pub(crate) fn clear_of_edges(&self, pos: V, r: f64) -> bool {
+        let mut clear = true;
+        for axis in 0..V::DIM {
+            let (lo, hi, x) = (self.min.get(axis), self.max.get(axis), pos.get(axis));
+            // `&`, not `&&`: no branch per comparison, whatever the optimiser decides.
+            clear &= match self.border {
+                Border::Wrap => (x >= lo) & (x < hi),
+                Border::Bounce | Border::Clamp => (x >= lo + r) & (x <= hi - r),
+            };
+        }
+        clear
+    }
+
     /// [`Topology::apply`] for a disk at or past an edge.
     #[cold]
-    fn apply_at_edges(&self, mut pos: V, mut vel: V, r: f64, e: f64) -> (V, V) {
+    pub(crate) fn apply_at_edges(&self, mut pos: V, mut vel: V, r: f64, e: f64) -> (V, V) {
         for axis in 0..V::DIM {
             let lo = self.min.get(axis);
             let hi = self.max.get(axis);

@@ -179,7 +179,7 @@ impl<V: Vector> Access<'_, V> {
             return None;
         }
         let topo = self.topo;
-        let (me, other) = self.critters.pair_mut(caller.index, arg.index);
+        let (me, other) = self.critters.pair_mut_moving(caller.index, arg.index);
         let hit = response::collide_default(topo, me, other)?;
         self.events.collisions.push(CollisionEvent {
             caller,

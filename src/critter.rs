@@ -121,6 +121,10 @@ pub struct Critter<V: Vector> {
     pub(crate) class: u32,
     pub(crate) fixed: bool,
     pub(crate) alive: bool,
+    /// True for a wall: what `shape` says, kept in the first cache line so that the passes
+    /// over every critter (move, hash) need not read the second one. Not hashed (the kind
+    /// says it too).
+    pub(crate) wall: bool,
     pub(crate) kind: KindId,
     pub(crate) priority: f64,
     /// Coefficient of restitution in [0, 1]; a pair uses the smaller of its two.
@@ -172,7 +176,8 @@ impl<V: Vector> Critter<V> {
     }
     /// True for walls.
     pub fn is_wall(&self) -> bool {
-        matches!(self.shape, Shape::Wall(_))
+        debug_assert_eq!(self.wall, matches!(self.shape, Shape::Wall(_)));
+        self.wall
     }
     /// The wall geometry, for walls.
     pub fn wall(&self) -> Option<&WallBox<V>> {

@@ -3,42 +3,87 @@
 //!
 //! Recording hashes every step, so this pass must cost little next to a step. Each critter is
 //! sixteen words ([`words`]): position, velocity, radius, mass, id, a word of flags (fixed,
-//! alive), kind, priority, restitution and health, the rest zero. Word `j` of every critter goes
-//! through its own lane `j`, `lane = (rotl(lane, 5) ^ word) * K`, critter after critter in slot
-//! order. Each update is a bijection of the lane for a fixed word and of the word for a fixed
-//! lane, so a change in any one word of any one critter always changes its lane, and the order
-//! of the critters counts.
+//! alive), kind, priority, restitution and health, the rest zero. Each word goes through a lane
+//! of its own, `lane = (rotl(lane, 5) ^ word) * K`, critter after critter in slot order. Each
+//! update is a bijection of the lane for a fixed word and of the word for a fixed lane, so a
+//! change in any one word of any one critter always changes its lane, and the order of the
+//! critters counts.
+//!
+//! - The first [`MOVING`] words (position, velocity, radius, mass; in 2D also id and flags) are
+//!   all that a step without hooks changes. They go through [`SETS`] interleaved sets of lanes:
+//!   the critter in slot `i` through set `i % SETS`. One chain of multiplies per lane would make
+//!   every critter wait for the last one's multiply; four chains run side by side.
+//! - The other words go through one set of lanes, which the critter set keeps between hashes
+//!   until something may have written them ([`Statics`]). A step of a scene without hooks then
+//!   reads one cache line of each 2D critter, not two.
+//! - The totals (kinetic energy, momentum) are summed in [`SETS`] interleaved sums too, added in
+//!   set order at the end ([`totals`], which [`crate::world::World::kinetic_energy`] uses).
 //!
 //! The words are the critter's fields in memory order (`repr(C)`, eight bytes a word, with the
-//! rule class and padding read as zero), and the lanes are independent, so on a CPU with
-//! AVX-512 the sixteen lanes are two vector registers and a critter costs two byte-masked loads
-//! and two rotate-xor-multiply steps: about 2.7 ns for a 2D critter against 4.9 ns for the
-//! scalar hash it replaced (`cargo bench --bench recording`, `recording_parts/hash`). Elsewhere
-//! the same arithmetic runs one lane at a time. Both give the same bits; the tests compare them
-//! on 2D and 3D worlds with every bit of every field flipped in turn.
+//! rule class, the wall flag and padding read as zero), so on a CPU with AVX-512 a critter's first eight words
+//! are one byte-masked load into one vector register, and its step one rotate-xor-multiply.
+//! Elsewhere the same arithmetic runs one lane at a time. Both give the same bits; the tests
+//! compare them on 2D and 3D worlds with every bit of every field flipped in turn.
 
 use crate::critter::{Critter, PropValue};
 use crate::hash::StateHasher;
 use crate::vector::Vector;
+use std::sync::{Mutex, PoisonError};
 
-/// Words per critter, and lanes.
+/// Words per critter.
 pub const WORDS: usize = 16;
+
+/// The first `MOVING` words of a critter hold everything a step changes when no hook writes to
+/// the critters: position, velocity, radius and mass (and in 2D id and flags).
+pub const MOVING: usize = 8;
+
+/// The words after the first [`MOVING`]: kind, priority, restitution, health (and in 3D id and
+/// flags).
+pub const STATIC: usize = WORDS - MOVING;
+
+/// Interleaved sets of lanes for the moving words, and of sums for the totals.
+pub const SETS: usize = 4;
+
+/// Lanes in all: [`SETS`] sets for the moving words, one for the rest.
+pub const LANES: usize = SETS * MOVING + STATIC;
 
 /// The odd multiplier of every lane (as in [`crate::hash`]).
 const K: u64 = 0x5851_F42D_4C95_7F2D;
 
-/// The lanes' starting values (splitmix64 of 1 to 16).
-const START: [u64; WORDS] = start();
+/// The lanes' starting values (splitmix64 of 1 to [`LANES`]): the moving sets, then the rest.
+const START: [u64; LANES] = start();
 
-const fn start() -> [u64; WORDS] {
-    let mut out = [0u64; WORDS];
+const fn start() -> [u64; LANES] {
+    let mut out = [0u64; LANES];
     let mut i = 0;
-    while i < WORDS {
+    while i < LANES {
         let mut z = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         out[i] = z ^ (z >> 31);
         i += 1;
+    }
+    out
+}
+
+/// The starting lanes of moving set `s`.
+const fn start_moving(s: usize) -> [u64; MOVING] {
+    let mut out = [0u64; MOVING];
+    let mut j = 0;
+    while j < MOVING {
+        out[j] = START[s * MOVING + j];
+        j += 1;
+    }
+    out
+}
+
+/// The starting lanes of the static words.
+const fn start_static() -> [u64; STATIC] {
+    let mut out = [0u64; STATIC];
+    let mut j = 0;
+    while j < STATIC {
+        out[j] = START[SETS * MOVING + j];
+        j += 1;
     }
     out
 }
@@ -56,7 +101,8 @@ fn id_word<V: Vector>(c: &Critter<V>) -> u64 {
 }
 
 /// Fixed and alive in one word, at the bits their bytes take in their word of the critter
-/// (bytes 4 and 5; bytes 0 to 3 are the rule class, which is a cache and not hashed).
+/// (bytes 4 and 5; bytes 0 to 3 are the rule class, a cache, and byte 6 the wall flag, which
+/// the kind says too: neither is hashed).
 #[inline(always)]
 fn flags_word<V: Vector>(c: &Critter<V>) -> u64 {
     (c.fixed as u64) << 32 | (c.alive as u64) << 40
@@ -66,8 +112,8 @@ fn flags_word<V: Vector>(c: &Critter<V>) -> u64 {
 /// - 2D: x, y, vx, vy, radius, mass, id, flags | kind, priority, restitution, health, 0, 0, 0, 0.
 /// - 3D: x, y, z, vx, vy, vz, radius, mass | id, flags, kind, priority, restitution, health, 0, 0.
 ///
-/// This is the order of the fields in memory, eight bytes per word (the rule class, a cache,
-/// and padding read as zero), so the AVX-512 pass loads each half with one masked load.
+/// This is the order of the fields in memory, eight bytes per word (the rule class, the wall
+/// flag and padding read as zero), so the AVX-512 pass loads each half with one masked load.
 #[inline(always)]
 pub fn words<V: Vector>(c: &Critter<V>) -> [u64; WORDS] {
     let f = |x: f64| x.to_bits();
@@ -91,60 +137,288 @@ pub fn words<V: Vector>(c: &Critter<V>) -> [u64; WORDS] {
     w
 }
 
+/// The kinetic energy and momentum of the free critters, in [`SETS`] interleaved sums.
+#[derive(Clone, Copy, Debug)]
+struct Sums<V> {
+    energy: [f64; SETS],
+    momentum: [V; SETS],
+}
+
+impl<V: Vector> Sums<V> {
+    fn new() -> Self {
+        Sums {
+            energy: [0.0; SETS],
+            momentum: [V::zero(); SETS],
+        }
+    }
+
+    /// Adds critter `c` to sum `s`.
+    #[inline(always)]
+    fn add(&mut self, s: usize, c: &Critter<V>) {
+        self.energy[s] += c.kinetic_energy();
+        if !c.fixed {
+            self.momentum[s] += c.vel * c.mass;
+        }
+    }
+
+    /// The sums added in set order.
+    #[inline(always)]
+    fn total(self) -> (f64, V) {
+        let mut energy = self.energy[0];
+        let mut momentum = self.momentum[0];
+        for s in 1..SETS {
+            energy += self.energy[s];
+            momentum += self.momentum[s];
+        }
+        (energy, momentum)
+    }
+}
+
+/// The kinetic energy and momentum of the free critters of `slots`, summed as every pass sums
+/// them: the critter in slot `i` into sum `i % SETS`, the sums added in order.
+pub fn totals<V: Vector>(slots: &[Option<Critter<V>>]) -> (f64, V) {
+    let mut sums = Sums::new();
+    for (i, c) in slots.iter().enumerate() {
+        if let Some(c) = c {
+            sums.add(i % SETS, c);
+        }
+    }
+    sums.total()
+}
+
 /// What one pass over the critters gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pass<V> {
-    /// The lanes after every critter.
-    pub lanes: [u64; WORDS],
-    /// Kinetic energy of the free critters, summed in slot order (as
-    /// [`crate::world::World::kinetic_energy`] sums it).
+    /// The lanes after every critter: the [`SETS`] moving sets, then the static set.
+    pub lanes: [u64; LANES],
+    /// Kinetic energy of the free critters (as [`totals`]).
     pub energy: f64,
-    /// Momentum of the free critters, summed in slot order.
+    /// Momentum of the free critters (as [`totals`]).
     pub momentum: V,
+}
+
+/// Calls `f(s, c)` for every critter `c` of `slots` in slot order, `s` its slot index modulo
+/// [`SETS`], with `s` a constant in the unrolled main loop (so sets indexed by it stay in
+/// registers).
+#[inline(always)]
+fn for_each_in_sets<V: Vector>(
+    slots: &[Option<Critter<V>>],
+    mut f: impl FnMut(usize, &Critter<V>),
+) {
+    let mut chunks = slots.chunks_exact(SETS);
+    for chunk in &mut chunks {
+        for (s, slot) in chunk.iter().enumerate() {
+            if let Some(c) = slot {
+                f(s, c);
+            }
+        }
+    }
+    for (s, slot) in chunks.remainder().iter().enumerate() {
+        if let Some(c) = slot {
+            f(s, c);
+        }
+    }
 }
 
 /// One pass over every critter of `slots` (empty slots skipped): the lanes, the totals, and
 /// non-empty properties hashed into `props`. Uses AVX-512 when the CPU has it.
 pub fn pass<V: Vector>(slots: &[Option<Critter<V>>], props: &mut StateHasher) -> Pass<V> {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx512bw")
-    {
+    if has_avx512() {
         // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { avx512::pass(slots, props) };
     }
     portable_pass(slots, props)
 }
 
-/// A critter's kinetic energy and momentum, added to the sums (in registers: a closure that
-/// captured the sums by reference kept them in memory, a store-to-load wait per critter).
-#[inline(always)]
-fn add_totals<V: Vector>(c: &Critter<V>, energy: &mut f64, momentum: &mut V) {
-    *energy += c.kinetic_energy();
-    if !c.fixed {
-        *momentum += c.vel * c.mass;
-    }
+#[cfg(target_arch = "x86_64")]
+fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512bw")
 }
 
 /// [`pass`] one lane at a time, on any CPU.
 pub fn portable_pass<V: Vector>(slots: &[Option<Critter<V>>], props: &mut StateHasher) -> Pass<V> {
-    let mut lanes = START;
-    let (mut energy, mut momentum) = (0.0, V::zero());
-    for c in slots.iter().flatten() {
-        add_totals(c, &mut energy, &mut momentum);
+    let mut moving = [0; SETS].map(start_moving);
+    let mut statics = start_static();
+    let mut sums = Sums::new();
+    for_each_in_sets(slots, |s, c| {
+        sums.add(s, c);
         let w = words(c);
-        for (lane, w) in lanes.iter_mut().zip(w) {
+        for (lane, &w) in moving[s].iter_mut().zip(&w[..MOVING]) {
+            *lane = mix(*lane, w);
+        }
+        for (lane, &w) in statics.iter_mut().zip(&w[MOVING..]) {
             *lane = mix(*lane, w);
         }
         if !c.props.is_empty() {
             hash_props(props, c);
         }
-    }
+    });
+    let (energy, momentum) = sums.total();
     Pass {
+        lanes: join(moving, statics),
+        energy,
+        momentum,
+    }
+}
+
+/// The moving sets and the static set as one row of lanes.
+fn join(moving: [[u64; MOVING]; SETS], statics: [u64; STATIC]) -> [u64; LANES] {
+    let mut lanes = [0u64; LANES];
+    for (s, set) in moving.iter().enumerate() {
+        lanes[s * MOVING..(s + 1) * MOVING].copy_from_slice(set);
+    }
+    lanes[SETS * MOVING..].copy_from_slice(&statics);
+    lanes
+}
+
+/// A critter's first [`MOVING`] words: the first half of [`words`].
+#[inline(always)]
+fn moving_words<V: Vector>(c: &Critter<V>) -> [u64; MOVING] {
+    let f = |x: f64| x.to_bits();
+    let mut w = [0u64; MOVING];
+    let d = V::DIM;
+    for axis in 0..d {
+        w[axis] = f(c.pos.get(axis));
+        w[d + axis] = f(c.vel.get(axis));
+    }
+    let rest = [f(c.radius), f(c.mass), id_word(c), flags_word(c)];
+    w[2 * d..].copy_from_slice(&rest[..MOVING - 2 * d]);
+    w
+}
+
+/// What a pass over the first [`MOVING`] words gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovingPass<V> {
+    /// The [`SETS`] moving sets of lanes after every critter.
+    pub lanes: [[u64; MOVING]; SETS],
+    /// As in [`Pass`].
+    pub energy: f64,
+    /// As in [`Pass`].
+    pub momentum: V,
+}
+
+/// [`pass`] over each critter's first [`MOVING`] words only (no properties).
+pub fn moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx512() {
+        // SAFETY: the CPU has the features the function is compiled for.
+        return unsafe { avx512::moving_pass(slots) };
+    }
+    portable_moving_pass(slots)
+}
+
+/// [`moving_pass`] one lane at a time, on any CPU.
+pub fn portable_moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+    let mut lanes = [0; SETS].map(start_moving);
+    let mut sums = Sums::new();
+    for_each_in_sets(slots, |s, c| {
+        sums.add(s, c);
+        for (lane, w) in lanes[s].iter_mut().zip(moving_words(c)) {
+            *lane = mix(*lane, w);
+        }
+    });
+    let (energy, momentum) = sums.total();
+    MovingPass {
         lanes,
         energy,
         momentum,
+    }
+}
+
+/// What the last whole pass over a set of critters left in the static lanes and in the
+/// properties' hash.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Kept {
+    lanes: [u64; STATIC],
+    props: u64,
+}
+
+/// The static lanes of a critter set, kept between hashes.
+///
+/// A step without hooks writes only positions and velocities (and the rule class, which is not
+/// hashed), so the next hash needs only the first [`MOVING`] words of each critter: one cache
+/// line of a 2D critter instead of two. The critter set drops what is kept on every write that
+/// could change anything else: insert, remove, and every mutable accessor but the engine's own
+/// `*_moving` ones, which write positions, velocities and rule classes only. Debug builds (the
+/// tests) check every reuse against a whole pass.
+#[derive(Debug, Default)]
+pub struct Statics(Mutex<Option<Kept>>);
+
+impl Clone for Statics {
+    /// A copy starts with nothing kept (its first hash is a whole pass).
+    fn clone(&self) -> Self {
+        Statics::default()
+    }
+}
+
+impl Statics {
+    /// Forgets what is kept: the next hash reads every word again.
+    #[inline]
+    pub(crate) fn forget(&mut self) {
+        *self.0.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
+    }
+
+    /// True when the next hash can reuse the kept lanes.
+    #[cfg(test)]
+    pub(crate) fn is_kept(&self) -> bool {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .is_some()
+    }
+}
+
+/// What [`hash_critters`] gives: every lane, the properties' hash, and the totals.
+#[derive(Clone, Copy, Debug)]
+pub struct Hashed<V> {
+    /// The lanes, as in [`Pass`].
+    pub lanes: [u64; LANES],
+    /// The properties' hash (see [`pass`]).
+    pub props: u64,
+    /// Kinetic energy of the free critters (as [`totals`]).
+    pub energy: f64,
+    /// Momentum of the free critters (as [`totals`]).
+    pub momentum: V,
+}
+
+/// The critters of `slots` hashed: the same bits as a whole [`pass`] (and the properties' hash),
+/// but reading only each critter's first [`MOVING`] words when `statics` still holds the rest.
+pub fn hash_critters<V: Vector>(slots: &[Option<Critter<V>>], statics: &Statics) -> Hashed<V> {
+    let mut kept = statics.0.lock().unwrap_or_else(PoisonError::into_inner);
+    if let Some(k) = *kept {
+        let m = moving_pass(slots);
+        let out = Hashed {
+            lanes: join(m.lanes, k.lanes),
+            props: k.props,
+            energy: m.energy,
+            momentum: m.momentum,
+        };
+        #[cfg(debug_assertions)]
+        {
+            let mut props = StateHasher::default();
+            let whole = pass(slots, &mut props);
+            assert!(
+                whole.lanes == out.lanes && props.finish() == out.props,
+                "the kept hash lanes are stale: a write to a critter's kind, priority, \
+                 restitution, health or properties went through a `*_moving` accessor"
+            );
+        }
+        return out;
+    }
+    let mut props = StateHasher::default();
+    let whole = pass(slots, &mut props);
+    let props = props.finish();
+    let mut lanes = [0u64; STATIC];
+    lanes.copy_from_slice(&whole.lanes[SETS * MOVING..]);
+    *kept = Some(Kept { lanes, props });
+    Hashed {
+        lanes: whole.lanes,
+        props,
+        energy: whole.energy,
+        momentum: whole.momentum,
     }
 }
 
@@ -186,9 +460,47 @@ mod avx512 {
         Some(masks)
     }
 
-    /// [`super::pass`] with the sixteen lanes in two AVX-512 registers: each half of a critter's
-    /// words is one byte-masked load of its fields (masked bytes are not read, so neither the
-    /// rule class nor any padding is), then one rotate-xor-multiply.
+    /// One rotate-xor-multiply of eight lanes.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    fn mix8(lanes: __m512i, w: __m512i, k: __m512i) -> __m512i {
+        _mm512_mullo_epi64(_mm512_xor_si512(_mm512_rol_epi64::<5>(lanes), w), k)
+    }
+
+    /// Eight lanes from memory.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    fn load8(lanes: &[u64; MOVING]) -> __m512i {
+        // SAFETY: eight u64 are 64 bytes (an unaligned load).
+        unsafe { _mm512_loadu_si512(lanes.as_ptr().cast()) }
+    }
+
+    /// Eight lanes to memory.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    fn store8(v: __m512i) -> [u64; MOVING] {
+        let mut out = [0u64; MOVING];
+        // SAFETY: `out` is 64 bytes (an unaligned store).
+        unsafe { _mm512_storeu_si512(out.as_mut_ptr().cast(), v) };
+        out
+    }
+
+    /// A critter's words under `mask`, from byte `offset` of the critter.
+    ///
+    /// # Safety
+    /// `mask` must cover only bytes of the critter's fields from `offset` (see [`byte_masks`]).
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    unsafe fn load_masked<V: Vector>(c: &Critter<V>, offset: usize, mask: u64) -> __m512i {
+        let p: *const i8 = (c as *const Critter<V>).cast();
+        // SAFETY: masked bytes are not read; the rest are initialised fields (the caller's
+        // promise).
+        unsafe { _mm512_maskz_loadu_epi8(mask, p.add(offset)) }
+    }
+
+    /// [`super::pass`] with each set of eight lanes in an AVX-512 register: each half of a
+    /// critter's words is one byte-masked load of its fields (masked bytes are not read, so
+    /// neither the rule class, the wall flag nor any padding is), then one rotate-xor-multiply.
     ///
     /// # Safety
     /// The CPU must have AVX-512F, DQ and BW.
@@ -201,34 +513,48 @@ mod avx512 {
             return portable_pass(slots, props);
         };
         let k = _mm512_set1_epi64(K as i64);
-        let mut a = _mm512_loadu_si512(START[..8].as_ptr().cast());
-        let mut b = _mm512_loadu_si512(START[8..].as_ptr().cast());
-        let (mut energy, mut momentum) = (0.0, V::zero());
-        for c in slots.iter().flatten() {
-            add_totals(c, &mut energy, &mut momentum);
-            let p: *const i8 = (c as *const Critter<V>).cast();
-            // SAFETY: both loads stay inside the critter (`byte_masks` checked every byte they
-            // read), and every byte they read is an initialised field.
-            let (wa, wb) = unsafe {
-                (
-                    _mm512_maskz_loadu_epi8(mask_a, p),
-                    _mm512_maskz_loadu_epi8(mask_b, p.add(64)),
-                )
-            };
-            a = _mm512_mullo_epi64(_mm512_xor_si512(_mm512_rol_epi64::<5>(a), wa), k);
-            b = _mm512_mullo_epi64(_mm512_xor_si512(_mm512_rol_epi64::<5>(b), wb), k);
+        let mut moving = [0; SETS].map(|s| load8(&start_moving(s)));
+        let mut statics = load8(&start_static());
+        let mut sums = Sums::new();
+        for_each_in_sets(slots, |s, c| {
+            sums.add(s, c);
+            // SAFETY: `byte_masks` checked every byte both loads read.
+            let (wa, wb) = unsafe { (load_masked(c, 0, mask_a), load_masked(c, 64, mask_b)) };
+            moving[s] = mix8(moving[s], wa, k);
+            statics = mix8(statics, wb, k);
             if !c.props.is_empty() {
                 hash_props(props, c);
             }
-        }
-        let mut out = [0u64; WORDS];
-        // SAFETY: `out` has room for both stores.
-        unsafe {
-            _mm512_storeu_si512(out[..8].as_mut_ptr().cast(), a);
-            _mm512_storeu_si512(out[8..].as_mut_ptr().cast(), b);
-        }
+        });
+        let (energy, momentum) = sums.total();
         Pass {
-            lanes: out,
+            lanes: join(moving.map(|v| store8(v)), store8(statics)),
+            energy,
+            momentum,
+        }
+    }
+
+    /// [`super::moving_pass`]: one masked load and one rotate-xor-multiply per critter.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F, DQ and BW.
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    pub unsafe fn moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+        let Some([mask_a, _]) = byte_masks::<V>() else {
+            return portable_moving_pass(slots);
+        };
+        let k = _mm512_set1_epi64(K as i64);
+        let mut moving = [0; SETS].map(|s| load8(&start_moving(s)));
+        let mut sums = Sums::new();
+        for_each_in_sets(slots, |s, c| {
+            sums.add(s, c);
+            // SAFETY: `byte_masks` checked every byte the load reads.
+            let wa = unsafe { load_masked(c, 0, mask_a) };
+            moving[s] = mix8(moving[s], wa, k);
+        });
+        let (energy, momentum) = sums.total();
+        MovingPass {
+            lanes: moving.map(|v| store8(v)),
             energy,
             momentum,
         }
@@ -279,7 +605,8 @@ fn hash_bytes(h: &mut StateHasher, bytes: &[u8]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::critter::PropValue;
+    use crate::critter::{CritterId, PropValue};
+    use crate::method::Method;
     use crate::scenes::{builtin, AnyWorld, SceneParams};
     use crate::world::World;
 
@@ -302,13 +629,22 @@ mod tests {
         let fast = pass(slots, &mut p1);
         let portable = portable_pass(slots, &mut p2);
         assert_eq!(p1.finish(), p2.finish(), "properties");
+        // The moving passes give the first lanes and the same totals.
+        for m in [moving_pass(slots), portable_moving_pass(slots)] {
+            assert_eq!(m.lanes.as_flattened(), &portable.lanes[..SETS * MOVING]);
+            assert_eq!(m.energy.to_bits(), portable.energy.to_bits());
+            assert_eq!(bits_of(m.momentum), bits_of(portable.momentum));
+        }
         (fast, portable)
     }
 
     /// The lanes and the totals' bits (a wall made free has infinite mass: NaN totals).
     fn bits<V: Vector>(p: &Pass<V>) -> (Vec<u64>, u64, Vec<u64>) {
-        let momentum = (0..V::DIM).map(|a| p.momentum.get(a).to_bits()).collect();
-        (p.lanes.to_vec(), p.energy.to_bits(), momentum)
+        (p.lanes.to_vec(), p.energy.to_bits(), bits_of(p.momentum))
+    }
+
+    fn bits_of<V: Vector>(v: V) -> Vec<u64> {
+        (0..V::DIM).map(|a| v.get(a).to_bits()).collect()
     }
 
     fn flip(x: &mut f64, bit: u32) {
@@ -415,6 +751,110 @@ mod tests {
             AnyWorld::D3(w) => every_bit_counts(w),
             AnyWorld::D2(_) => panic!("gas3d is 3D"),
         }
+    }
+
+    /// The hash of `w` from every word: what is kept is dropped first.
+    fn whole_hash<V: Vector>(w: &mut World<V>) -> u64 {
+        w.critters.forget_statics();
+        assert!(!w.critters.statics().is_kept());
+        w.state_hash()
+    }
+
+    /// Steps `w` by `method`, checking after each step that the kept lanes are still there and
+    /// that the hash that reuses them is the hash of every word.
+    fn steps_keep_the_lanes<V: Vector>(mut w: World<V>, method: Method) {
+        w.set_method(method).expect("a method");
+        w.state_hash();
+        for step in 0..20 {
+            w.step().expect("steps");
+            // Moving, colliding and bouncing off the walls leave the kept lanes in place...
+            assert!(w.critters.statics().is_kept(), "{method:?}, step {step}");
+            // ...and the hash that reuses them is the hash of every word.
+            let kept = w.state_hash();
+            assert_eq!(kept, whole_hash(&mut w), "{method:?}, step {step}");
+        }
+    }
+
+    #[test]
+    fn a_step_without_hooks_reuses_the_kept_lanes_and_gets_the_whole_hash() {
+        for method in [
+            Method::Discrete,
+            Method::Substep(3),
+            Method::Swept,
+            Method::Event,
+        ] {
+            match scene("gas") {
+                AnyWorld::D2(w) => steps_keep_the_lanes(w, method),
+                AnyWorld::D3(_) => panic!("gas is 2D"),
+            }
+            match scene("gas3d") {
+                AnyWorld::D3(w) => steps_keep_the_lanes(w, method),
+                AnyWorld::D2(_) => panic!("gas3d is 3D"),
+            }
+        }
+    }
+
+    #[test]
+    fn every_mutable_accessor_forgets_the_kept_lanes() {
+        let AnyWorld::D2(mut w) = scene("gas") else {
+            panic!("gas is 2D")
+        };
+        let id = w.critters().iter().next().expect("a critter").id;
+        type Write = fn(&mut World<glam::DVec2>, CritterId);
+        let writes: [(&str, Write); 6] = [
+            ("World::get_mut", |w, id| {
+                w.get_mut(id).expect("there").health -= 1.0
+            }),
+            ("CritterSet::get_mut", |w, id| {
+                w.critters.get_mut(id).expect("there").restitution = 0.5
+            }),
+            ("CritterSet::slot_mut", |w, id| {
+                let c = w.critters.slot_mut(id.index).expect("there");
+                c.set_priority(1.0).expect("a priority");
+            }),
+            ("CritterSet::pair_mut", |w, id| {
+                let (a, _) = w.critters.pair_mut(id.index, id.index + 1);
+                a.props.insert("tag".into(), PropValue::Int(7));
+            }),
+            ("CritterSet::iter_mut", |w, _| {
+                w.critters.iter_mut().for_each(|c| c.health += 1.0)
+            }),
+            ("CritterSet::par_iter_mut", |w, _| {
+                use rayon::prelude::*;
+                w.critters.par_iter_mut().for_each(|c| c.kind.0 ^= 0)
+            }),
+        ];
+        for (name, write) in writes {
+            let before = w.state_hash();
+            assert!(w.critters.statics().is_kept(), "{name}");
+            write(&mut w, id);
+            assert!(!w.critters.statics().is_kept(), "{name}");
+            let after = w.state_hash();
+            assert_eq!(after, whole_hash(&mut w), "{name}");
+            if name != "CritterSet::par_iter_mut" {
+                assert_ne!(after, before, "{name} changed a field");
+            }
+        }
+        // Removing and spawning change the slots.
+        w.state_hash();
+        w.remove(id).expect("there");
+        assert!(!w.critters.statics().is_kept(), "remove");
+        let after = w.state_hash();
+        assert_eq!(after, whole_hash(&mut w), "remove");
+    }
+
+    /// What the debug check is for: a write of a kept field through an accessor that promises
+    /// to write only positions and velocities is caught at the next hash.
+    #[cfg(debug_assertions)]
+    #[test]
+    #[should_panic(expected = "the kept hash lanes are stale")]
+    fn a_kept_field_written_behind_the_hash_is_caught() {
+        let AnyWorld::D2(mut w) = scene("gas") else {
+            panic!("gas is 2D")
+        };
+        w.state_hash();
+        w.critters.slot_mut_moving(0).expect("there").health = -5.0;
+        w.state_hash();
     }
 
     #[cfg(target_arch = "x86_64")]

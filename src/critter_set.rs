@@ -5,15 +5,21 @@
 //! deterministic, whatever was added or removed.
 
 use crate::critter::{Critter, CritterId};
+use crate::critter_hash::Statics;
 use crate::vector::Vector;
 
 /// The critters of a world.
+///
+/// Every mutable accessor marks the critters as possibly changed in any field, so the next
+/// state hash reads them whole; the engine's own `*_moving` accessors, which write positions,
+/// velocities and rule classes only, do not (see [`Statics`]).
 #[derive(Clone, Debug)]
 pub struct CritterSet<V: Vector> {
     slots: Vec<Option<Critter<V>>>,
     generations: Vec<u32>,
     free: Vec<u32>,
     live: usize,
+    statics: Statics,
 }
 
 impl<V: Vector> Default for CritterSet<V> {
@@ -23,6 +29,7 @@ impl<V: Vector> Default for CritterSet<V> {
             generations: Vec::new(),
             free: Vec::new(),
             live: 0,
+            statics: Statics::default(),
         }
     }
 }
@@ -30,6 +37,7 @@ impl<V: Vector> Default for CritterSet<V> {
 impl<V: Vector> CritterSet<V> {
     /// Inserts the critter built by `make` for its new id. O(1) amortised.
     pub fn insert(&mut self, make: impl FnOnce(CritterId) -> Critter<V>) -> CritterId {
+        self.statics.forget();
         let index = match self.free.pop() {
             Some(i) => i,
             None => {
@@ -53,6 +61,7 @@ impl<V: Vector> CritterSet<V> {
         if self.generations.get(i) != Some(&id.generation) {
             return None;
         }
+        self.statics.forget();
         let critter = self.slots[i].take()?;
         self.live -= 1;
         // A slot whose generation would wrap is retired rather than reused.
@@ -75,6 +84,7 @@ impl<V: Vector> CritterSet<V> {
     /// The critter with id `id`, mutably.
     #[inline]
     pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.statics.forget();
         match self.slots.get_mut(id.index as usize) {
             Some(Some(c)) if c.id == id => Some(c),
             _ => None,
@@ -90,6 +100,14 @@ impl<V: Vector> CritterSet<V> {
     /// The critter in slot `index`, mutably.
     #[inline]
     pub fn slot_mut(&mut self, index: u32) -> Option<&mut Critter<V>> {
+        self.statics.forget();
+        self.slot_mut_moving(index)
+    }
+
+    /// [`CritterSet::slot_mut`] for the engine's writes of position, velocity and rule class
+    /// only (anything else written through it would leave the next state hash stale).
+    #[inline]
+    pub(crate) fn slot_mut_moving(&mut self, index: u32) -> Option<&mut Critter<V>> {
         self.slots.get_mut(index as usize).and_then(Option::as_mut)
     }
 
@@ -99,6 +117,13 @@ impl<V: Vector> CritterSet<V> {
     /// If `a == b` or either slot is empty: callers pass slots from this step's pairs.
     #[inline]
     pub fn pair_mut(&mut self, a: u32, b: u32) -> (&mut Critter<V>, &mut Critter<V>) {
+        self.statics.forget();
+        self.pair_mut_moving(a, b)
+    }
+
+    /// [`CritterSet::pair_mut`] for the engine's writes of position and velocity only.
+    #[inline]
+    pub(crate) fn pair_mut_moving(&mut self, a: u32, b: u32) -> (&mut Critter<V>, &mut Critter<V>) {
         assert_ne!(a, b, "a critter cannot collide with itself");
         let (a, b) = (a as usize, b as usize);
         let (first, second) = if a < b {
@@ -136,6 +161,14 @@ impl<V: Vector> CritterSet<V> {
 
     /// The critters, in slot order, in parallel (each is visited by one thread).
     pub fn par_iter_mut(&mut self) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
+        self.statics.forget();
+        self.par_iter_mut_moving()
+    }
+
+    /// [`CritterSet::par_iter_mut`] for the engine's writes of position and velocity only.
+    pub(crate) fn par_iter_mut_moving(
+        &mut self,
+    ) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
         use rayon::prelude::*;
         self.slots.par_iter_mut().filter_map(Option::as_mut)
     }
@@ -143,6 +176,17 @@ impl<V: Vector> CritterSet<V> {
     /// Every slot, in order (empty ones are `None`).
     pub(crate) fn slot_slice(&self) -> &[Option<Critter<V>>] {
         &self.slots
+    }
+
+    /// The hash lanes kept for the critters' rarely changing words.
+    pub(crate) fn statics(&self) -> &Statics {
+        &self.statics
+    }
+
+    /// Drops the kept hash lanes (tests compare a hash that reused them with one that did not).
+    #[cfg(test)]
+    pub(crate) fn forget_statics(&mut self) {
+        self.statics.forget();
     }
 
     /// The free slots, in the order they are kept (the last is reused first), as the ids their
@@ -169,6 +213,7 @@ impl<V: Vector> CritterSet<V> {
             generations: vec![u32::MAX; slots_needed],
             free: Vec::with_capacity(free.len()),
             live: 0,
+            statics: Statics::default(),
         };
         for c in critters {
             let i = c.id.index as usize;
@@ -192,6 +237,13 @@ impl<V: Vector> CritterSet<V> {
 
     /// The critters, in slot order, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
+        self.statics.forget();
+        self.iter_mut_moving()
+    }
+
+    /// [`CritterSet::iter_mut`] for the engine's writes of position, velocity and rule class
+    /// only.
+    pub(crate) fn iter_mut_moving(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.slots.iter_mut().filter_map(Option::as_mut)
     }
 }

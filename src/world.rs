@@ -439,21 +439,14 @@ impl<V: Vector> World<V> {
         &self.rules
     }
 
-    /// Total kinetic energy of the free critters, summed in slot order.
+    /// Total kinetic energy of the free critters, in four interleaved sums over the slots added
+    /// in order ([`crate::critter_hash::totals`]: the recording's totals have the same bits).
     pub fn kinetic_energy(&self) -> f64 {
-        let mut e = 0.0;
-        for c in self.critters.iter() {
-            e += c.kinetic_energy();
-        }
-        e
+        crate::critter_hash::totals(self.critters.slot_slice()).0
     }
-    /// Total momentum of the free critters.
+    /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
-        let mut p = V::zero();
-        for c in self.critters.iter().filter(|c| !c.fixed) {
-            p += c.vel * c.mass;
-        }
-        p
+        crate::critter_hash::totals(self.critters.slot_slice()).1
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
@@ -493,16 +486,18 @@ impl<V: Vector> World<V> {
         for w in self.rng.state() {
             h.word(w);
         }
-        // Every critter's fields in sixteen lanes (src/critter_hash.rs); properties go to a
-        // hasher of their own, after their owner's id.
-        let mut props = StateHasher::default();
-        let pass = crate::critter_hash::pass(self.critters.slot_slice(), &mut props);
+        // Every critter's fields in lanes (src/critter_hash.rs), the rarely changing ones reused
+        // from the last hash when nothing could have written them; properties go to a hasher of
+        // their own, after their owner's id.
+        const _: () = assert!(crate::critter_hash::LANES.is_multiple_of(LANES));
+        let pass =
+            crate::critter_hash::hash_critters(self.critters.slot_slice(), self.critters.statics());
         for half in pass.lanes.chunks_exact(LANES) {
             let mut w = [0u64; LANES];
             w.copy_from_slice(half);
             h.words(w);
         }
-        h.word(props.finish());
+        h.word(pass.props);
         (h.finish(), pass.energy, pass.momentum)
     }
 
@@ -538,6 +533,7 @@ impl<V: Vector> World<V> {
             health: 1.0,
             fixed: true,
             alive: true,
+            wall: true,
             shape: Shape::Wall(Box::new(wall)),
             props: Default::default(),
         });
@@ -670,6 +666,7 @@ impl<V: Vector> World<V> {
             health,
             fixed,
             alive: true,
+            wall: false,
             shape: Shape::Disk,
             props: {
                 let mut props = d.props.clone();
@@ -843,7 +840,7 @@ impl<V: Vector> World<V> {
         let (g, topo) = (self.gravity, self.topo);
         let dv = g * dt;
         // Each critter moves on its own, so any split over threads gives the same bits.
-        let step = |c: &mut Critter<V>| {
+        let step = move |c: &mut Critter<V>| {
             if !c.alive || c.is_wall() {
                 return;
             }
@@ -851,15 +848,18 @@ impl<V: Vector> World<V> {
                 c.vel += dv;
             }
             let moved = c.pos + c.vel * dt;
-            let (pos, vel) = topo.apply(moved, c.vel, c.radius, c.restitution);
-            c.pos = pos;
-            c.vel = vel;
+            // Restitution (in the critter's second cache line) is read only at an edge.
+            if topo.clear_of_edges(moved, c.radius) {
+                c.pos = moved;
+            } else {
+                (c.pos, c.vel) = topo.apply_at_edges(moved, c.vel, c.radius, c.restitution);
+            }
         };
         if self.critters.len() >= PARALLEL_MIN {
             use rayon::prelude::*;
-            self.critters.par_iter_mut().for_each(step);
+            self.critters.par_iter_mut_moving().for_each(step);
         } else {
-            self.critters.iter_mut().for_each(step);
+            self.critters.iter_mut_moving().for_each(step);
         }
     }
 
@@ -911,7 +911,7 @@ impl<V: Vector> World<V> {
         if seen.unset {
             for c in self
                 .critters
-                .iter_mut()
+                .iter_mut_moving()
                 .filter(|c| c.alive && c.class == CLASS_UNSET)
             {
                 c.class = self.rules.class_of(&self.kinds, c);
@@ -1040,7 +1040,11 @@ impl<V: Vector> World<V> {
         if self.topo.wraps() {
             // Separation may have pushed a critter across the periodic edge.
             let topo = self.topo;
-            for c in self.critters.iter_mut().filter(|c| c.alive && !c.is_wall()) {
+            for c in self
+                .critters
+                .iter_mut_moving()
+                .filter(|c| c.alive && !c.is_wall())
+            {
                 c.pos = topo.wrap_position(c.pos);
             }
         }

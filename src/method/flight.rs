@@ -336,7 +336,7 @@ fn run_with<V: Vector>(
     let topo = w.topo;
     for a in 0..n {
         advance(w, sc, a, t_end);
-        if let Some(c) = w.critters.slot_mut(a) {
+        if let Some(c) = w.critters.slot_mut_moving(a) {
             if c.alive && !c.is_wall() {
                 c.pos = if topo.wraps() {
                     topo.wrap_position(c.pos)
@@ -362,7 +362,7 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     let mut rmax: f64 = 0.0;
     let mut disks = 0usize;
     sc.has_walls = false;
-    for c in w.critters.iter_mut() {
+    for c in w.critters.iter_mut_moving() {
         if c.class == CLASS_UNSET {
             c.class = w.rules.class_of(&w.kinds, c);
         }
@@ -597,7 +597,7 @@ fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     body.pos = p;
     body.vel = v;
     body.t = t;
-    if let Some(c) = w.critters.slot_mut(a) {
+    if let Some(c) = w.critters.slot_mut_moving(a) {
         c.pos = p;
         c.vel = v;
     }
@@ -1055,7 +1055,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
     let (axis, side) = ((tag / 2) as usize, tag % 2);
     let border = w.topo.border;
     let (lo, hi) = (w.topo.min.get(axis), w.topo.max.get(axis));
-    let c = w.critters.slot_mut(a).expect("live slot");
+    let c = w.critters.slot_mut_moving(a).expect("live slot");
     let bound = if side == 1 {
         hi - c.radius
     } else {
@@ -1171,7 +1171,7 @@ fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32
     let n = sc.dims[axis] as i64;
     if w.topo.wraps() && (cc[axis] < 0 || cc[axis] >= n) {
         let len = w.topo.size().get(axis);
-        let c = w.critters.slot_mut(a).expect("live slot");
+        let c = w.critters.slot_mut_moving(a).expect("live slot");
         let x = c.pos.get(axis);
         c.pos.set(axis, if dir == 1 { x - len } else { x + len });
     }
@@ -1200,7 +1200,7 @@ fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     let mut p = c.pos;
     if w.topo.wraps() {
         p = w.topo.wrap_position(p);
-        w.critters.slot_mut(a).expect("live").pos = p;
+        w.critters.slot_mut_moving(a).expect("live").pos = p;
     }
     let new = cell_of(w, sc, p);
     move_cell(sc, a, old, new);

@@ -50,7 +50,7 @@ pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<()
     }
     let clock = std::time::Instant::now();
     let dv = world.gravity * world.dt;
-    for c in world.critters.iter_mut() {
+    for c in world.critters.iter_mut_moving() {
         if c.alive && !c.fixed && !c.is_wall() {
             c.vel += dv;
         }

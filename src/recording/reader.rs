@@ -301,7 +301,8 @@ impl Recording {
             theirs == super::schema::STATE_HASH,
             "{}: its state hashes were computed by state hash version {theirs}, and this \
              critterbox computes version {} (critterbox changed how it hashes a state on \
-             2026-12-01), so they cannot be checked; record the run again with this critterbox",
+             2026-12-01 and 2026-12-02), so they cannot be checked; record the run again with \
+             this critterbox",
             self.path.display(),
             super::schema::STATE_HASH
         );

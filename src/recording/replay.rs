@@ -201,6 +201,7 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
             health: s.health.0[i],
             fixed,
             alive: s.alive[i],
+            wall: false,
             shape: Shape::Disk,
             props: s
                 .props

@@ -84,6 +84,22 @@ pub struct Recorder {
     batch: Vec<StepRecord>,
 }
 
+/// Lowers the calling thread's scheduling priority (nice 10), so that on a busy machine the
+/// simulation thread and rayon's workers get the cores before the recorder does. The recorder
+/// cannot fall behind for long: the queue is bounded, and a full queue makes the simulation
+/// thread wait. Linux only, where nice belongs to a thread (elsewhere it would be the process).
+///
+/// Measured on the 10,000-critter gas (docs/recording-format.md): the default recording's
+/// median cost went from +10.2% to +7.1% of the step in the same 21 interleaved rounds.
+fn yield_to_the_simulation() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: setpriority reads its three integer arguments only; `who` 0 is the calling thread.
+    // A failure (not possible when raising one's own nice value) leaves the priority as it was.
+    unsafe {
+        libc::setpriority(libc::PRIO_PROCESS, 0, 10);
+    }
+}
+
 fn write_err(path: &Path, e: impl std::fmt::Display) -> RecordError {
     RecordError::Write {
         path: path.to_path_buf(),
@@ -139,6 +155,7 @@ impl Recorder {
         let thread = std::thread::Builder::new()
             .name("critterbox-recorder".into())
             .spawn(move || {
+                yield_to_the_simulation();
                 let out = Output {
                     w,
                     channels,
