@@ -22,7 +22,7 @@ use crate::vector::Vector;
 pub const SMALL_N: usize = 100;
 
 /// An object for the broad phase: a centre and per-axis half sizes of its bounding box.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BroadObject<V> {
     /// Centre of the bounding box.
     pub center: V,

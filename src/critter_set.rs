@@ -178,6 +178,11 @@ impl<V: Vector> CritterSet<V> {
         &self.slots
     }
 
+    /// Every slot, mutably, for the engine's writes of position and velocity only.
+    pub(crate) fn slots_mut_moving(&mut self) -> &mut [Option<Critter<V>>] {
+        &mut self.slots
+    }
+
     /// The hash lanes kept for the critters' rarely changing words.
     pub(crate) fn statics(&self) -> &Statics {
         &self.statics

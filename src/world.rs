@@ -230,6 +230,12 @@ pub struct World<V: Vector> {
     pub(crate) stats: StepStats,
     pub(crate) totals: StepStats,
     pub(crate) objs: Vec<BroadObject<V>>,
+    /// What the move stage did for the broad phase's input pass, which follows it at once (see
+    /// [`World::stage_move`]); `None` when no move just ran.
+    moved: Option<Moved>,
+    /// How many objects each chunk of [`INPUT_CHUNK`] slots gave `objs` when it was last built
+    /// on rayon's threads (empty otherwise): the parts the next move stage fills.
+    input_counts: Vec<usize>,
     pub(crate) candidates: Vec<(u32, u32)>,
     /// (caller, arg, roles still to ask the hooks for)
     pub(crate) ruled: Vec<(u32, u32, bool)>,
@@ -267,6 +273,8 @@ impl<V: Vector> World<V> {
             stats: StepStats::default(),
             totals: StepStats::default(),
             objs: Vec::new(),
+            moved: None,
+            input_counts: Vec::new(),
             candidates: Vec::new(),
             ruled: Vec::new(),
             contacts: Vec::new(),
@@ -729,6 +737,7 @@ impl<V: Vector> World<V> {
     /// then part-way through that step.
     pub fn step(&mut self) -> Result<(), Error> {
         self.events.clear();
+        self.moved = None;
         self.stats = StepStats::default();
         let mut stats = StepStats::default();
 
@@ -856,52 +865,90 @@ impl<V: Vector> World<V> {
             }
         };
         if self.critters.len() >= PARALLEL_MIN {
+            // Each chunk of slots also does the broad phase's input pass, while its critters are
+            // in cache (at a million critters that pass was two more trips through 128 MB of
+            // critters): it counts its objects and what the survey sees, and writes its objects
+            // into its part of `objs` as the last build cut them. If every chunk has as many
+            // objects as then (no critter came or went), `objs` is complete; otherwise the broad
+            // phase fills it from the counts.
             use rayon::prelude::*;
-            self.critters.par_iter_mut_moving().for_each(step);
+            let slots = self.critters.slots_mut_moving();
+            let chunks = slots.len().div_ceil(INPUT_CHUNK);
+            let reuse = self.input_counts.len() == chunks
+                && self.input_counts.iter().sum::<usize>() == self.objs.len();
+            let mut parts: Vec<&mut [BroadObject<V>]> = Vec::with_capacity(chunks);
+            if reuse {
+                let mut rest = self.objs.as_mut_slice();
+                for &n in &self.input_counts {
+                    let (part, tail) = rest.split_at_mut(n);
+                    parts.push(part);
+                    rest = tail;
+                }
+            } else {
+                parts.resize_with(chunks, || &mut []);
+            }
+            let seen: Vec<(usize, Survey, bool)> = slots
+                .par_chunks_mut(INPUT_CHUNK)
+                .zip(parts)
+                .map(|(chunk, part)| {
+                    let (mut n, mut seen) = (0, Survey::default());
+                    for c in chunk.iter_mut().flatten() {
+                        step(c);
+                        seen = seen.and(Survey::of(c));
+                        if let Some(o) = broad_object(c) {
+                            if let Some(slot) = part.get_mut(n) {
+                                *slot = o;
+                            }
+                            n += 1;
+                        }
+                    }
+                    (n, seen, n == part.len())
+                })
+                .collect();
+            self.moved = Some(Moved {
+                objs_filled: reuse && seen.iter().all(|&(_, _, full)| full),
+                chunks: seen.into_iter().map(|(n, s, _)| (n, s)).collect(),
+            });
         } else {
             self.critters.iter_mut_moving().for_each(step);
         }
     }
 
     fn stage_broad_phase(&mut self) {
-        let object = |c: &Critter<V>| -> Option<BroadObject<V>> {
-            if !c.alive {
-                return None;
-            }
-            let (half, is_wall) = match &c.shape {
-                Shape::Disk => (V::splat(c.radius), false),
-                Shape::Wall(w) => (w.aabb_half(), true),
-            };
-            Some(BroadObject {
-                center: c.pos,
-                half,
-                slot: c.id.index,
-                is_wall,
-            })
-        };
-        // What the same pass learns on the way, so no other pass over the critters is needed.
-        let survey = |c: &Critter<V>| Survey {
-            unset: c.alive && c.class == CLASS_UNSET,
-            largest_radius: if c.alive && !c.is_wall() {
-                c.radius
-            } else {
-                0.0
-            },
-        };
+        // What the move stage did, if it ran just before over the same slots.
+        let moved = self
+            .moved
+            .take()
+            .filter(|m| m.chunks.len() == self.critters.slot_count().div_ceil(INPUT_CHUNK));
         let seen = if self.critters.len() >= PARALLEL_MIN {
-            filter_map_in_order(
-                self.critters.slot_slice(),
-                &mut self.objs,
-                |s| s.as_ref().and_then(object),
-                |s| s.as_ref().map_or(Survey::default(), survey),
-                Survey::and,
-            )
+            let slots = self.critters.slot_slice();
+            let (chunks, filled) = match moved {
+                Some(m) => (m.chunks, m.objs_filled),
+                None => {
+                    let chunks = count_in_chunks(
+                        slots,
+                        |s| s.as_ref().is_some_and(|c| c.alive),
+                        |s| s.as_ref().map_or(Survey::default(), Survey::of),
+                        Survey::and,
+                    );
+                    (chunks, false)
+                }
+            };
+            if !filled {
+                fill_in_order(slots, &mut self.objs, &chunks, |s| {
+                    s.as_ref().and_then(broad_object)
+                });
+            }
+            self.input_counts.clear();
+            self.input_counts.extend(chunks.iter().map(|&(n, _)| n));
+            chunks.iter().fold(Survey::default(), |s, &(_, c)| s.and(c))
         } else {
+            self.input_counts.clear();
             self.objs.clear();
             let mut seen = Survey::default();
             for c in self.critters.iter() {
-                seen = seen.and(survey(c));
-                if let Some(o) = object(c) {
+                seen = seen.and(Survey::of(c));
+                if let Some(o) = broad_object(c) {
                     self.objs.push(o);
                 }
             }
@@ -1179,6 +1226,34 @@ fn hook_error<V: Vector>(
     }
 }
 
+/// A live critter's box for the broad phase. Only a wall's box is read from its shape, so a
+/// disk's second cache line stays untouched.
+#[inline]
+fn broad_object<V: Vector>(c: &Critter<V>) -> Option<BroadObject<V>> {
+    if !c.alive {
+        return None;
+    }
+    let half = match (c.is_wall(), &c.shape) {
+        (true, Shape::Wall(w)) => w.aabb_half(),
+        _ => V::splat(c.radius),
+    };
+    Some(BroadObject {
+        center: c.pos,
+        half,
+        slot: c.id.index,
+        is_wall: c.is_wall(),
+    })
+}
+
+/// What the move stage did for the broad phase's input pass (see [`World::stage_move`]).
+#[derive(Clone, Debug)]
+struct Moved {
+    /// Each chunk's number of objects and survey.
+    chunks: Vec<(usize, Survey)>,
+    /// True when the move also wrote every object into `objs`, in order.
+    objs_filled: bool,
+}
+
 /// What the broad phase's input pass learns about the critters on the way.
 #[derive(Clone, Copy, Debug, Default)]
 struct Survey {
@@ -1189,6 +1264,19 @@ struct Survey {
 }
 
 impl Survey {
+    /// What one critter adds.
+    #[inline]
+    fn of<V: Vector>(c: &Critter<V>) -> Survey {
+        Survey {
+            unset: c.alive && c.class == CLASS_UNSET,
+            largest_radius: if c.alive && !c.is_wall() {
+                c.radius
+            } else {
+                0.0
+            },
+        }
+    }
+
     fn and(self, other: Survey) -> Survey {
         Survey {
             unset: self.unset || other.unset,
@@ -1197,51 +1285,64 @@ impl Survey {
     }
 }
 
-/// `out` = `items` filtered and mapped by `f`, in order, computed on rayon's threads into `out`'s
-/// own buffer: each chunk counts its outputs (and sums up `survey` of its items with `and`),
-/// then each fills its own part of `out`. So the result is the sequential one for any thread
-/// count, and a buffer reused from step to step allocates nothing (rayon's own unindexed collect
-/// builds fresh vectors every call and copies them together: at 100,000 critters that was page
-/// faults and copies every step). Returns the chunks' surveys combined in order.
-fn filter_map_in_order<T: Sync, U: Copy + Send, S: Copy + Send + Default>(
+/// Slots per chunk of the parallel passes over the critters that build the broad phase's input.
+const INPUT_CHUNK: usize = 4096;
+
+/// For each chunk of [`INPUT_CHUNK`] items, on rayon's threads: how many pass `keep`, and their
+/// `survey`s combined with `and`. With [`fill_in_order`], a filter-map into a reused buffer
+/// whose result is the sequential one for any thread count (rayon's own unindexed collect builds
+/// fresh vectors every call and copies them together: at 100,000 critters that was page faults
+/// and copies every step).
+fn count_in_chunks<T: Sync, S: Copy + Send + Default>(
     items: &[T],
-    out: &mut Vec<U>,
-    f: impl Fn(&T) -> Option<U> + Sync,
+    keep: impl Fn(&T) -> bool + Sync,
     survey: impl Fn(&T) -> S + Sync,
     and: impl Fn(S, S) -> S + Sync,
-) -> S {
+) -> Vec<(usize, S)> {
     use rayon::prelude::*;
-    const CHUNK: usize = 4096;
-    let counts: Vec<(usize, S)> = items
-        .par_chunks(CHUNK)
+    items
+        .par_chunks(INPUT_CHUNK)
         .map(|chunk| {
             chunk.iter().fold((0, S::default()), |(n, s), t| {
-                (n + f(t).is_some() as usize, and(s, survey(t)))
+                (n + keep(t) as usize, and(s, survey(t)))
             })
         })
-        .collect();
-    let seen = counts.iter().fold(S::default(), |s, &(_, c)| and(s, c));
+        .collect()
+}
+
+/// `out` = `items` filtered and mapped by `f`, in order, on rayon's threads: each chunk of
+/// [`INPUT_CHUNK`] items fills its own part of `out`, sized by `counts` (each chunk's number of
+/// items `f` maps to `Some`, from [`count_in_chunks`] or from a pass that counted the same).
+fn fill_in_order<T: Sync, U: Copy + Send, S>(
+    items: &[T],
+    out: &mut Vec<U>,
+    counts: &[(usize, S)],
+    f: impl Fn(&T) -> Option<U> + Sync,
+) {
+    use rayon::prelude::*;
     out.clear();
     let Some(first) = items.iter().find_map(&f) else {
-        return seen;
+        return;
     };
     out.resize(counts.iter().map(|&(n, _)| n).sum(), first);
     let mut parts = Vec::with_capacity(counts.len());
     let mut rest = out.as_mut_slice();
-    for &(n, _) in &counts {
+    for &(n, _) in counts {
         let (part, tail) = rest.split_at_mut(n);
         parts.push(part);
         rest = tail;
     }
     items
-        .par_chunks(CHUNK)
+        .par_chunks(INPUT_CHUNK)
         .zip(parts)
         .for_each(|(chunk, part)| {
+            let mut filled = 0;
             for (slot, u) in part.iter_mut().zip(chunk.iter().filter_map(&f)) {
                 *slot = u;
+                filled += 1;
             }
+            debug_assert_eq!(filled, part.len(), "a chunk's count was wrong");
         });
-    seen
 }
 
 /// "(1, 2.5)" or "(1, 2.5, 0)".
@@ -1253,9 +1354,73 @@ pub fn fmt_vec<V: Vector>(v: V) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec2;
+
+    /// The broad phase's input as a fresh pass over the critters builds it.
+    fn fresh_objects<V: Vector>(w: &World<V>) -> Vec<BroadObject<V>> {
+        w.critters.iter().filter_map(broad_object).collect()
+    }
+
+    /// `objs` after a step against a fresh pass, with the walls' widening taken out and the
+    /// centres of the critters the response moved (those in a contact) not compared.
+    fn check_objects<V: Vector>(w: &World<V>, what: &str) {
+        let mut objs = w.objs.clone();
+        let fresh = fresh_objects(w);
+        assert_eq!(objs.len(), fresh.len(), "{what}");
+        let touched: std::collections::BTreeSet<u32> =
+            w.contacts.iter().flat_map(|&(a, b)| [a, b]).collect();
+        for (o, f) in objs.iter_mut().zip(&fresh) {
+            if o.is_wall {
+                o.half = f.half;
+            }
+            if touched.contains(&o.slot) {
+                o.center = f.center;
+            }
+        }
+        assert!(
+            objs == fresh,
+            "{what}: the objects differ from a fresh pass"
+        );
+        assert!(
+            touched.len() < objs.len() / 10,
+            "{what}: most centres compared"
+        );
+    }
 
     #[test]
-    fn filter_map_in_order_matches_the_sequential_filter_map_on_any_thread_count() {
+    fn the_move_stage_builds_the_broad_phase_input_as_a_fresh_pass_does() {
+        // Above PARALLEL_MIN, so the move stage fills the objects; positions are read after the
+        // move, as the broad phase reads them.
+        let params = crate::scenes::SceneParams {
+            n: Some(PARALLEL_MIN + 5000),
+            ..Default::default()
+        };
+        let crate::scenes::AnyWorld::D2(mut w) = crate::scenes::builtin("gas", &params)
+            .expect("builds")
+            .world
+        else {
+            panic!("gas is 2D")
+        };
+        w.step().expect("steps");
+        check_objects(&w, "first step");
+        w.step().expect("steps");
+        check_objects(&w, "second step");
+        // A critter gone (its chunk has one object fewer than the last build cut for it), then
+        // one more: the parts no longer fit, and the broad phase fills the objects itself.
+        let gone = w.critters().iter().nth(7000).expect("a critter").id;
+        w.remove(gone).expect("there");
+        w.step().expect("steps");
+        check_objects(&w, "after a removal");
+        w.spawn(CritterSpec::new("ball", DVec2::new(1.0, 1.0)))
+            .expect("spawns");
+        w.step().expect("steps");
+        check_objects(&w, "after a spawn");
+        w.step().expect("steps");
+        check_objects(&w, "a step later");
+    }
+
+    #[test]
+    fn count_and_fill_match_the_sequential_filter_map_on_any_thread_count() {
         // Sizes around the chunk size; the survey (a sum of the items) must match too.
         for n in [0usize, 1, 7, 4095, 4096, 4097, 12_289] {
             // Keep every item, every third, every thousandth, or none (0).
@@ -1270,8 +1435,12 @@ mod tests {
                         .build()
                         .expect("a pool");
                     let mut out = vec![99u64; 5]; // stale contents must not survive
-                    let sum = pool
-                        .install(|| filter_map_in_order(&items, &mut out, f, |&i| i, |a, b| a + b));
+                    let sum = pool.install(|| {
+                        let keep = |i: &usize| f(i).is_some();
+                        let counts = count_in_chunks(&items, keep, |&i| i, |a, b| a + b);
+                        fill_in_order(&items, &mut out, &counts, f);
+                        counts.iter().map(|&(_, s)| s).sum::<usize>()
+                    });
                     assert_eq!(out, expected, "n {n}, keep every {keep_every}");
                     assert_eq!(sum, n * n.saturating_sub(1) / 2, "n {n}");
                 }
