@@ -8,7 +8,10 @@
 //! The two engines are stepped in alternating rounds, so a load spike on this shared machine hits
 //! both; medians of the rounds are reported, and their ratio.
 //!
-//! Usage: `cargo run --release -- [N ...] [--steps S] [--rounds R] [--drift-steps D]`
+//! Usage: `cargo run --release -- [N ...] [--steps S] [--rounds R] [--drift-steps D]`, or
+//! `--chart PREFIX` for the chart of `docs/performance.md` (see `chart.rs`).
+
+mod chart;
 
 use critterbox::glam::DVec2;
 use critterbox::scenes::{gas, GasParams};
@@ -30,30 +33,56 @@ struct Rapier {
     handles: Vec<RigidBodyHandle>,
 }
 
+/// The bodies of a critterbox gas as plain data, so rapier can be built after the critterbox
+/// world is gone (the memory measurement).
+struct Bodies {
+    /// Position, velocity and radius of each disk.
+    disks: Vec<(DVec2, DVec2, f64)>,
+    /// Centre and half sizes of each wall.
+    walls: Vec<(DVec2, DVec2)>,
+    dt: f64,
+}
+
+impl Bodies {
+    fn of(world: &critterbox::World<DVec2>) -> Bodies {
+        let mut b = Bodies {
+            disks: Vec::new(),
+            walls: Vec::new(),
+            dt: world.dt(),
+        };
+        for c in world.critters().iter() {
+            match c.wall() {
+                Some(wall) => b.walls.push((c.pos, wall.half)),
+                None => b.disks.push((c.pos, c.vel, c.radius())),
+            }
+        }
+        b
+    }
+}
+
 impl Rapier {
-    fn from(world: &critterbox::World<DVec2>) -> Rapier {
+    fn from(scene: &Bodies) -> Rapier {
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
         let mut handles = Vec::new();
-        for c in world.critters().iter() {
-            if let Some(wall) = c.wall() {
-                let body = bodies
-                    .insert(RigidBodyBuilder::fixed().translation(Vector::new(c.pos.x, c.pos.y)));
-                let collider = ColliderBuilder::cuboid(wall.half.x, wall.half.y)
-                    .restitution(1.0)
-                    .friction(0.0)
-                    .restitution_combine_rule(CoefficientCombineRule::Max)
-                    .friction_combine_rule(CoefficientCombineRule::Min);
-                colliders.insert_with_parent(collider, body, &mut bodies);
-                continue;
-            }
+        for &(center, half) in &scene.walls {
+            let body = bodies
+                .insert(RigidBodyBuilder::fixed().translation(Vector::new(center.x, center.y)));
+            let collider = ColliderBuilder::cuboid(half.x, half.y)
+                .restitution(1.0)
+                .friction(0.0)
+                .restitution_combine_rule(CoefficientCombineRule::Max)
+                .friction_combine_rule(CoefficientCombineRule::Min);
+            colliders.insert_with_parent(collider, body, &mut bodies);
+        }
+        for &(pos, vel, radius) in &scene.disks {
             let body = bodies.insert(
                 RigidBodyBuilder::dynamic()
-                    .translation(Vector::new(c.pos.x, c.pos.y))
-                    .linvel(Vector::new(c.vel.x, c.vel.y))
+                    .translation(Vector::new(pos.x, pos.y))
+                    .linvel(Vector::new(vel.x, vel.y))
                     .lock_rotations(),
             );
-            let collider = ColliderBuilder::ball(c.radius())
+            let collider = ColliderBuilder::ball(radius)
                 .restitution(1.0)
                 .friction(0.0)
                 .restitution_combine_rule(CoefficientCombineRule::Max)
@@ -62,7 +91,7 @@ impl Rapier {
             handles.push(body);
         }
         let params = IntegrationParameters {
-            dt: world.dt(),
+            dt: scene.dt,
             ..IntegrationParameters::default()
         };
         Rapier {
@@ -118,16 +147,28 @@ const USAGE: &str = "\
 critterbox against rapier2d-f64 on the standard 2D gas, in one process
 
 Usage: critterbox-vs-rapier [N ...] [--steps S] [--rounds R] [--drift-steps D] [--threads T]
+       critterbox-vs-rapier --chart PREFIX [N ...] [--steps S] [--rounds R] [--rapier-max M]
+                            [--warmup W]
 
   N                critter counts to compare (default: 1000 10000 100000)
   --steps S        steps per timed round (default 20)
   --rounds R       alternating rounds; the medians are reported (default 7)
   --drift-steps D  steps over which kinetic energy drift is measured (default 300)
   --threads T      critterbox's threads (default 1, as rapier here; its stages go parallel
-                   from 20,000 critters)";
+                   from 20,000 critters)
+  --chart PREFIX   instead: ms per step of critterbox 2D and 3D on 1 and 2 threads and of
+                   rapier2d-f64 on 1, in alternating rounds, and bytes per critter of each
+                   engine built and stepped alone in a child process; a table, and a chart in
+                   PREFIX.svg and PREFIX.png (default N: 1000 10000 100000 1000000)
+  --rapier-max M   with --chart: the largest N rapier is run at (default 100000)
+  --warmup W       with --chart: W untimed steps of every world first (default 0: timed from
+                   the grid start, as the anchor figures for rapier are)";
 
 /// The command line.
 struct Args {
+    chart: Option<String>,
+    rapier_max: usize,
+    warmup: usize,
     sizes: Vec<usize>,
     steps: usize,
     rounds: usize,
@@ -139,6 +180,7 @@ struct Args {
 fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut sizes = Vec::new();
     let (mut steps, mut rounds, mut drift_steps, mut threads) = (20, 7, 300, 1);
+    let (mut chart, mut rapier_max, mut warmup) = (None, 100_000, 0);
     while let Some(a) = args.next() {
         let mut number = |what: &str| -> Result<usize, String> {
             args.next()
@@ -152,6 +194,11 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
             "--rounds" => rounds = number("--rounds")?,
             "--drift-steps" => drift_steps = number("--drift-steps")?,
             "--threads" => threads = number("--threads")?,
+            "--rapier-max" => rapier_max = number("--rapier-max")?,
+            "--warmup" => warmup = number("--warmup")?,
+            "--chart" => {
+                chart = Some(args.next().ok_or("--chart needs a file name prefix")?);
+            }
             n => match n.parse::<usize>() {
                 Ok(n) if n > 0 => sizes.push(n),
                 _ => return Err(format!("unknown argument {n:?}")),
@@ -159,6 +206,9 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
         }
     }
     Ok(Args {
+        chart,
+        rapier_max,
+        warmup,
         sizes,
         steps,
         rounds,
@@ -168,7 +218,20 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
 }
 
 fn main() {
+    // The child of `--chart` that measures one engine's memory.
+    let argv: Vec<String> = std::env::args().collect();
+    if argv.get(1).map(String::as_str) == Some("--memory-of") {
+        let n = argv.get(3).and_then(|n| n.parse().ok()).unwrap_or(0);
+        if let Err(e) = chart::memory_of(argv.get(2).map_or("", String::as_str), n) {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+        return;
+    }
     let Args {
+        chart,
+        rapier_max,
+        warmup,
         mut sizes,
         steps,
         rounds,
@@ -185,6 +248,18 @@ fn main() {
             std::process::exit(2);
         }
     };
+    if let Some(prefix) = chart {
+        if sizes.is_empty() {
+            sizes = vec![1_000, 10_000, 100_000, 1_000_000];
+        }
+        let rows = chart::measure(&sizes, steps, rounds, rapier_max, warmup);
+        chart::print_table(&rows);
+        if let Err(e) = chart::draw_files(&rows, &prefix) {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+        return;
+    }
     if sizes.is_empty() {
         sizes = vec![1_000, 10_000, 100_000];
     }
@@ -204,7 +279,7 @@ fn main() {
             ..GasParams::default()
         };
         let mut ours = gas::<DVec2>(&params).expect("the gas builds");
-        let mut theirs = Rapier::from(&ours);
+        let mut theirs = Rapier::from(&Bodies::of(&ours));
         // Energy drift over `drift_steps` steps, from the same start.
         let (e0_ours, e0_theirs) = (ours.kinetic_energy(), theirs.energy());
         let (mut t_ours, mut t_theirs) = (Vec::new(), Vec::new());
