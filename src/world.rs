@@ -945,14 +945,11 @@ impl<V: Vector> World<V> {
         } else {
             self.input_counts.clear();
             self.objs.clear();
-            let mut seen = Survey::default();
-            for c in self.critters.iter() {
-                seen = seen.and(Survey::of(c));
-                if let Some(o) = broad_object(c) {
-                    self.objs.push(o);
-                }
-            }
-            seen
+            self.objs
+                .extend(self.critters.iter().filter_map(broad_object));
+            self.critters
+                .iter()
+                .fold(Survey::default(), |s, c| s.and(Survey::of(c)))
         };
         // New critters and changed priorities need their rule class (rare; sequential).
         if seen.unset {
@@ -1233,16 +1230,25 @@ fn broad_object<V: Vector>(c: &Critter<V>) -> Option<BroadObject<V>> {
     if !c.alive {
         return None;
     }
-    let half = match (c.is_wall(), &c.shape) {
-        (true, Shape::Wall(w)) => w.aabb_half(),
-        _ => V::splat(c.radius),
-    };
-    Some(BroadObject {
+    let mut o = BroadObject {
         center: c.pos,
-        half,
+        half: V::splat(c.radius),
         slot: c.id.index,
         is_wall: c.is_wall(),
-    })
+    };
+    if o.is_wall {
+        o.half = wall_half(c);
+    }
+    Some(o)
+}
+
+/// A wall's box half sizes (walls are few: kept out of [`broad_object`]'s loop).
+#[cold]
+fn wall_half<V: Vector>(c: &Critter<V>) -> V {
+    match &c.shape {
+        Shape::Wall(w) => w.aabb_half(),
+        Shape::Disk => V::splat(c.radius),
+    }
 }
 
 /// What the move stage did for the broad phase's input pass (see [`World::stage_move`]).
