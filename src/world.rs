@@ -945,11 +945,14 @@ impl<V: Vector> World<V> {
         } else {
             self.input_counts.clear();
             self.objs.clear();
-            self.objs
-                .extend(self.critters.iter().filter_map(broad_object));
-            self.critters
-                .iter()
-                .fold(Survey::default(), |s, c| s.and(Survey::of(c)))
+            let mut seen = Survey::default();
+            for c in self.critters.iter() {
+                seen = seen.and(Survey::of(c));
+                if let Some(o) = broad_object(c) {
+                    self.objs.push(o);
+                }
+            }
+            seen
         };
         // New critters and changed priorities need their rule class (rare; sequential).
         if seen.unset {
@@ -1242,8 +1245,8 @@ fn broad_object<V: Vector>(c: &Critter<V>) -> Option<BroadObject<V>> {
     Some(o)
 }
 
-/// A wall's box half sizes (walls are few: kept out of [`broad_object`]'s loop).
-#[cold]
+/// A wall's box half sizes.
+#[inline]
 fn wall_half<V: Vector>(c: &Critter<V>) -> V {
     match &c.shape {
         Shape::Wall(w) => w.aabb_half(),
