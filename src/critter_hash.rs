@@ -66,26 +66,27 @@ const fn start() -> [u64; LANES] {
     out
 }
 
-/// The starting lanes of moving set `s`.
-const fn start_moving(s: usize) -> [u64; MOVING] {
+/// Eight starting lanes, from lane `first` of [`START`]: moving set `s` starts at `s * MOVING`,
+/// the static set at `SETS * MOVING`.
+const fn start_set(first: usize) -> [u64; MOVING] {
     let mut out = [0u64; MOVING];
     let mut j = 0;
     while j < MOVING {
-        out[j] = START[s * MOVING + j];
+        out[j] = START[first + j];
         j += 1;
     }
     out
 }
 
-/// The starting lanes of the static words.
+/// The starting lanes of moving set `s`.
+const fn start_moving(s: usize) -> [u64; MOVING] {
+    start_set(s * MOVING)
+}
+
+/// The starting lanes of the static words (as many as the moving ones: one register each).
 const fn start_static() -> [u64; STATIC] {
-    let mut out = [0u64; STATIC];
-    let mut j = 0;
-    while j < STATIC {
-        out[j] = START[SETS * MOVING + j];
-        j += 1;
-    }
-    out
+    const _: () = assert!(MOVING == STATIC);
+    start_set(SETS * MOVING)
 }
 
 #[inline(always)]

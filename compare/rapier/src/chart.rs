@@ -33,9 +33,13 @@ pub const SETUPS: [&str; 5] = [
     "rapier2d-f64 2D, 1 thread",
 ];
 
-/// The engines whose memory is measured (one child process each), and the set-up their figure
-/// belongs to.
-const MEMORY: [(&str, usize); 3] = [("critterbox2d", 0), ("critterbox3d", 2), ("rapier2d", 4)];
+/// The engines whose memory is measured (one child process each), the set-up their figure
+/// belongs to, and their label in the chart.
+const MEMORY: [(&str, usize, &str); 3] = [
+    ("critterbox2d", 0, "critterbox 2D"),
+    ("critterbox3d", 2, "critterbox 3D"),
+    ("rapier2d", 4, "rapier2d-f64 2D"),
+];
 
 /// One N's figures: ms per step and bytes per critter of each set-up (`None`: not run).
 pub struct Row {
@@ -123,7 +127,7 @@ pub fn measure(
         }
         let ms = times.map(|t| (!t.is_empty()).then(|| median(t)));
         let mut bytes = [None; 5];
-        for (engine, setup) in MEMORY {
+        for (engine, setup, _) in MEMORY {
             if engine != "rapier2d" || n <= rapier_max {
                 bytes[setup] = memory_of_child(engine, n);
             }
@@ -309,21 +313,9 @@ where
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
-    for (i, name) in SETUPS.iter().enumerate() {
-        let pts = series(|r| r.ms, i);
-        let color = style(i);
-        chart
-            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-        chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
+    let lines = SETUPS.iter().enumerate();
+    let lines = lines.map(|(i, name)| (*name, style(i), series(|r| r.ms, i)));
+    draw_lines(&mut chart, lines, SeriesLabelPosition::UpperLeft)?;
 
     let mut chart = ChartBuilder::on(&right)
         .caption(
@@ -341,25 +333,36 @@ where
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0}"))
         .draw()?;
-    for (engine, i) in MEMORY {
-        let pts = series(|r| r.bytes, i);
-        let color = style(i);
+    let lines = MEMORY.map(|(_, i, label)| (label, style(i), series(|r| r.bytes, i)));
+    draw_lines(&mut chart, lines, SeriesLabelPosition::UpperRight)?;
+    root.present()?;
+    Ok(())
+}
+
+/// Each line of `lines` (label, colour, points) as a line with a dot at every point, and the
+/// legend at `legend`.
+fn draw_lines<'a, DB: DrawingBackend + 'a, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    lines: impl IntoIterator<Item = (&'static str, RGBAColor, Vec<(f64, f64)>)>,
+    legend: SeriesLabelPosition,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+    DB::ErrorType: 'static,
+{
+    for (label, color, pts) in lines {
         chart
             .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
-            .label(match engine {
-                "critterbox2d" => "critterbox 2D",
-                "critterbox3d" => "critterbox 3D",
-                _ => "rapier2d-f64 2D",
-            })
+            .label(label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(legend)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()?;
-    root.present()?;
     Ok(())
 }
