@@ -162,13 +162,6 @@ impl<V: Vector> CritterSet<V> {
     /// The critters, in slot order, in parallel (each is visited by one thread).
     pub fn par_iter_mut(&mut self) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
         self.statics.forget();
-        self.par_iter_mut_moving()
-    }
-
-    /// [`CritterSet::par_iter_mut`] for the engine's writes of position and velocity only.
-    pub(crate) fn par_iter_mut_moving(
-        &mut self,
-    ) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
         use rayon::prelude::*;
         self.slots.par_iter_mut().filter_map(Option::as_mut)
     }

@@ -876,17 +876,13 @@ impl<V: Vector> World<V> {
             let chunks = slots.len().div_ceil(INPUT_CHUNK);
             let reuse = self.input_counts.len() == chunks
                 && self.input_counts.iter().sum::<usize>() == self.objs.len();
-            let mut parts: Vec<&mut [BroadObject<V>]> = Vec::with_capacity(chunks);
-            if reuse {
-                let mut rest = self.objs.as_mut_slice();
-                for &n in &self.input_counts {
-                    let (part, tail) = rest.split_at_mut(n);
-                    parts.push(part);
-                    rest = tail;
-                }
+            let parts = if reuse {
+                split_into(&mut self.objs, self.input_counts.iter().copied())
             } else {
-                parts.resize_with(chunks, || &mut []);
-            }
+                (0..chunks)
+                    .map(|_| <&mut [BroadObject<V>]>::default())
+                    .collect()
+            };
             let seen: Vec<(usize, Survey, bool)> = slots
                 .par_chunks_mut(INPUT_CHUNK)
                 .zip(parts)
@@ -1334,13 +1330,7 @@ fn fill_in_order<T: Sync, U: Copy + Send, S>(
         return;
     };
     out.resize(counts.iter().map(|&(n, _)| n).sum(), first);
-    let mut parts = Vec::with_capacity(counts.len());
-    let mut rest = out.as_mut_slice();
-    for &(n, _) in counts {
-        let (part, tail) = rest.split_at_mut(n);
-        parts.push(part);
-        rest = tail;
-    }
+    let parts = split_into(out, counts.iter().map(|&(n, _)| n));
     items
         .par_chunks(INPUT_CHUNK)
         .zip(parts)
@@ -1352,6 +1342,18 @@ fn fill_in_order<T: Sync, U: Copy + Send, S>(
             }
             debug_assert_eq!(filled, part.len(), "a chunk's count was wrong");
         });
+}
+
+/// `items` cut into consecutive parts of the given lengths (which must not add up to more).
+fn split_into<T>(items: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut rest = items;
+    lengths
+        .map(|n| {
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(n);
+            rest = tail;
+            part
+        })
+        .collect()
 }
 
 /// "(1, 2.5)" or "(1, 2.5, 0)".
