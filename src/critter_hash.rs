@@ -278,15 +278,9 @@ fn join(moving: [[u64; MOVING]; SETS], statics: [u64; STATIC]) -> [u64; LANES] {
 /// A critter's first [`MOVING`] words: the first half of [`words`].
 #[inline(always)]
 fn moving_words<V: Vector>(c: &Critter<V>) -> [u64; MOVING] {
-    let f = |x: f64| x.to_bits();
+    // Inlined, the loads of the words not kept are dropped.
     let mut w = [0u64; MOVING];
-    let d = V::DIM;
-    for axis in 0..d {
-        w[axis] = f(c.pos.get(axis));
-        w[d + axis] = f(c.vel.get(axis));
-    }
-    let rest = [f(c.radius), f(c.mass), id_word(c), flags_word(c)];
-    w[2 * d..].copy_from_slice(&rest[..MOVING - 2 * d]);
+    w.copy_from_slice(&words(c)[..MOVING]);
     w
 }
 
