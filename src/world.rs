@@ -39,6 +39,10 @@ use std::time::{Duration, Instant};
 /// results do not depend on the number of threads).
 pub const PARALLEL_MIN: usize = 20_000;
 
+/// Steps with at least this many candidate pairs ask the rules and test the pairs in parallel
+/// chunks of [`INPUT_CHUNK`] pairs (joined in order: the same lists for any thread count).
+const PARALLEL_PAIRS: usize = 2 * INPUT_CHUNK;
+
 /// The settings a world is made with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorldConfig<V: Vector> {
@@ -979,6 +983,14 @@ impl<V: Vector> World<V> {
 
     fn stage_rules(&mut self) -> Result<(), Error> {
         self.ruled.clear();
+        if self.candidates.len() >= PARALLEL_PAIRS && self.rules_in_parallel() {
+            return Ok(());
+        }
+        self.rules_in_order()
+    }
+
+    /// The rules stage, one candidate after another.
+    fn rules_in_order(&mut self) -> Result<(), Error> {
         for &(a, b) in &self.candidates {
             let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
                 continue;
@@ -1000,9 +1012,102 @@ impl<V: Vector> World<V> {
         Ok(())
     }
 
+    /// The rules stage in parallel chunks of candidates, joined in order (the same `ruled` for
+    /// any thread count), when every candidate's rule is already in the class table: the
+    /// stage's time is the critters' cache misses, which two cores wait for side by side. False,
+    /// with `ruled` left empty, if some pair's rule is still to be computed (that may run a
+    /// script, one at a time).
+    fn rules_in_parallel(&mut self) -> bool {
+        use rayon::prelude::*;
+        let (critters, rules) = (&self.critters, &self.rules);
+        let parts: Vec<Option<Vec<(u32, u32, bool)>>> = self
+            .candidates
+            .par_chunks(INPUT_CHUNK)
+            .map(|chunk| {
+                let mut part = Vec::with_capacity(chunk.len());
+                for &(a, b) in chunk {
+                    let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
+                        continue;
+                    };
+                    match rules.cached(ca.class, cb.class)? {
+                        Some(rule) => {
+                            if let Some((caller, arg)) = roles_order(rule, ca, cb) {
+                                part.push((caller.id.index, arg.id.index, false));
+                            }
+                        }
+                        None => part.push((a, b, true)),
+                    }
+                }
+                Some(part)
+            })
+            .collect();
+        if parts.iter().any(Option::is_none) {
+            return false;
+        }
+        for part in parts.into_iter().flatten() {
+            self.ruled.extend(part);
+        }
+        true
+    }
+
     fn stage_narrow_phase(&mut self) -> Result<(), Error> {
         self.contacts.clear();
         self.wall_pairs.clear();
+        if self.ruled.len() < PARALLEL_PAIRS || !self.narrow_phase_in_parallel() {
+            self.narrow_phase_in_order()?;
+        }
+        self.contacts
+            .sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
+        self.wall_pairs
+            .sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
+        Ok(())
+    }
+
+    /// The narrow phase in parallel chunks of pairs, joined in order, when no touching pair's
+    /// roles are still to be asked (asking may run a script). False, with nothing written,
+    /// otherwise. The lists are sorted afterwards, and no pair is in them twice, so their order
+    /// is the sequential pass's.
+    fn narrow_phase_in_parallel(&mut self) -> bool {
+        use rayon::prelude::*;
+        type Part = (Vec<(u32, u32)>, Vec<(u32, u32, bool)>);
+        let (critters, topo) = (&self.critters, &self.topo);
+        let parts: Vec<Option<Part>> = self
+            .ruled
+            .par_chunks(INPUT_CHUNK)
+            .map(|chunk| {
+                let (mut contacts, mut walls) = (Vec::new(), Vec::new());
+                for &(first, second, ask) in chunk {
+                    let (Some(a), Some(b)) = (critters.slot(first), critters.slot(second)) else {
+                        continue;
+                    };
+                    if a.is_wall() || b.is_wall() {
+                        walls.push((first, second, ask));
+                    } else if crate::contact::touching_ball_ball(
+                        topo.delta(a.pos, b.pos),
+                        a.radius,
+                        b.radius,
+                    ) {
+                        if ask {
+                            return None;
+                        }
+                        contacts.push((first, second));
+                    }
+                }
+                Some((contacts, walls))
+            })
+            .collect();
+        if parts.iter().any(Option::is_none) {
+            return false;
+        }
+        for (contacts, walls) in parts.into_iter().flatten() {
+            self.contacts.extend(contacts);
+            self.wall_pairs.extend(walls);
+        }
+        true
+    }
+
+    /// The narrow phase, one pair after another.
+    fn narrow_phase_in_order(&mut self) -> Result<(), Error> {
         let topo = &self.topo;
         for &(first, second, ask) in &self.ruled {
             let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
@@ -1026,10 +1131,6 @@ impl<V: Vector> World<V> {
                 self.contacts.push((first, second));
             }
         }
-        self.contacts
-            .sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
-        self.wall_pairs
-            .sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
         Ok(())
     }
 
@@ -1366,6 +1467,51 @@ pub fn fmt_vec<V: Vector>(v: V) -> String {
 mod tests {
     use super::*;
     use glam::DVec2;
+
+    /// The parallel rules and narrow phase give the lists of the sequential ones, on a gas with
+    /// walls that has settled into many candidate pairs.
+    #[test]
+    fn rules_and_narrow_phase_in_parallel_match_them_in_order() {
+        let mut w = crate::scenes::gas::<DVec2>(&crate::scenes::GasParams {
+            n: 40_000,
+            packing: 0.45,
+            ..Default::default()
+        })
+        .unwrap();
+        let mut checked = 0;
+        for _ in 0..30 {
+            w.step().unwrap();
+            w.stage_broad_phase();
+            if w.candidates.len() < INPUT_CHUNK {
+                continue;
+            }
+            w.ruled.clear();
+            w.rules_in_order().unwrap();
+            let in_order = w.ruled.clone();
+            w.ruled.clear();
+            assert!(w.rules_in_parallel(), "every class pair is in the table");
+            assert_eq!(w.ruled, in_order);
+
+            let sorted = |w: &World<DVec2>| {
+                let mut c = w.contacts.clone();
+                c.sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
+                let mut p = w.wall_pairs.clone();
+                p.sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
+                (c, p)
+            };
+            w.contacts.clear();
+            w.wall_pairs.clear();
+            w.narrow_phase_in_order().unwrap();
+            let in_order = sorted(&w);
+            w.contacts.clear();
+            w.wall_pairs.clear();
+            assert!(w.narrow_phase_in_parallel(), "no pair's roles are asked");
+            assert_eq!(sorted(&w), in_order);
+            assert!(!in_order.0.is_empty() && !in_order.1.is_empty());
+            checked += 1;
+        }
+        assert!(checked >= 5, "only {checked} steps had enough candidates");
+    }
 
     /// The broad phase's input as a fresh pass over the critters builds it.
     fn fresh_objects<V: Vector>(w: &World<V>) -> Vec<BroadObject<V>> {
