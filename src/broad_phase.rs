@@ -220,6 +220,76 @@ impl<V: Vector> Level<V> {
         &self.sorted[self.start[key] as usize..self.start[key + 1] as usize]
     }
 
+    /// The sorted objects cut into runs of whole cells of about `size` objects, in order.
+    fn cell_runs(&self, size: usize) -> Vec<std::ops::Range<usize>> {
+        let m = self.sorted.len();
+        let mut runs = Vec::with_capacity(m / size + 1);
+        let mut begin = 0;
+        while begin < m {
+            let mut end = (begin + size).min(m);
+            while end < m && self.sorted_keys[end] == self.sorted_keys[end - 1] {
+                end += 1;
+            }
+            runs.push(begin..end);
+            begin = end;
+        }
+        runs
+    }
+
+    /// Appends the pairs of this level's objects in `run` (whole cells of `sorted`) with each
+    /// other and with the cells at the `forward` offsets (`deltas` as key offsets); returns the
+    /// number of box tests.
+    fn pairs_within(
+        &self,
+        topo: &Topology<V>,
+        forward: &[[i32; 3]],
+        deltas: &[isize],
+        run: std::ops::Range<usize>,
+        out: &mut Vec<(u32, u32)>,
+    ) -> u64 {
+        let mut tests = 0;
+        let mut begin = run.start;
+        while begin < run.end {
+            let key = self.sorted_keys[begin] as usize;
+            let mut end = begin + 1;
+            while end < run.end && self.sorted_keys[end] as usize == key {
+                end += 1;
+            }
+            let here = &self.sorted[begin..end];
+            let c = self.decode(key);
+            begin = end;
+            for (j, a) in here.iter().enumerate() {
+                for b in &here[j + 1..] {
+                    tests += 1;
+                    if overlaps(topo, a, b) {
+                        out.push((a.slot, b.slot));
+                    }
+                }
+            }
+            let interior = self.interior(c);
+            for (&o, &delta) in forward.iter().zip(deltas) {
+                let nk = if interior {
+                    (key as isize + delta) as usize
+                } else {
+                    match self.neighbour(c, o) {
+                        Some(nk) => nk,
+                        None => continue,
+                    }
+                };
+                let there = self.cell(nk);
+                for a in here {
+                    for b in there {
+                        tests += 1;
+                        if overlaps(topo, a, b) {
+                            out.push((a.slot, b.slot));
+                        }
+                    }
+                }
+            }
+        }
+        tests
+    }
+
     /// Offsets to visit: `forward` = only those after (0,0,0) in (z, y, x) order.
     fn offsets(&self, forward: bool) -> Vec<[i32; 3]> {
         let range = |axis: usize| -> Vec<i32> {
@@ -338,6 +408,9 @@ impl<V: Vector> Level<V> {
         cell
     }
 }
+
+/// Objects per run of cells walked by one task when a level's pairs are found in parallel.
+const RUN_OBJECTS: usize = 8192;
 
 /// The skin of the Verlet list, as a fraction of the objects' typical width.
 const SKIN: f64 = 0.4;
@@ -628,50 +701,33 @@ impl<V: Vector> BroadPhase<V> {
         self.levels_used = used.len();
 
         // Pairs within each level: own cell, then the forward half of the neighbours, walking
-        // the occupied cells in order.
+        // the occupied cells in order. On a large level, runs of whole cells are walked in
+        // parallel and their pairs joined in order: the same list for any thread count.
         for &l in &used {
             let level = &self.levels[l];
             let forward = level.offsets(true);
             let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
+            let walk = |run: std::ops::Range<usize>, out: &mut Vec<(u32, u32)>| {
+                level.pairs_within(topo, &forward, &deltas, run, out)
+            };
             let m = level.sorted.len();
-            let mut begin = 0;
-            while begin < m {
-                let key = level.sorted_keys[begin] as usize;
-                let mut end = begin + 1;
-                while end < m && level.sorted_keys[end] as usize == key {
-                    end += 1;
+            if m >= crate::world::PARALLEL_MIN {
+                use rayon::prelude::*;
+                let runs = level.cell_runs(RUN_OBJECTS);
+                let parts: Vec<(Vec<(u32, u32)>, u64)> = runs
+                    .into_par_iter()
+                    .map(|run| {
+                        let mut part = Vec::new();
+                        let tests = walk(run, &mut part);
+                        (part, tests)
+                    })
+                    .collect();
+                for (part, tests) in parts {
+                    out.extend(part);
+                    self.tests += tests;
                 }
-                let here = &level.sorted[begin..end];
-                let c = level.decode(key);
-                begin = end;
-                for (j, a) in here.iter().enumerate() {
-                    for b in &here[j + 1..] {
-                        self.tests += 1;
-                        if overlaps(topo, a, b) {
-                            out.push((a.slot, b.slot));
-                        }
-                    }
-                }
-                let interior = level.interior(c);
-                for (&o, &delta) in forward.iter().zip(&deltas) {
-                    let nk = if interior {
-                        (key as isize + delta) as usize
-                    } else {
-                        match level.neighbour(c, o) {
-                            Some(nk) => nk,
-                            None => continue,
-                        }
-                    };
-                    let there = level.cell(nk);
-                    for a in here {
-                        for b in there {
-                            self.tests += 1;
-                            if overlaps(topo, a, b) {
-                                out.push((a.slot, b.slot));
-                            }
-                        }
-                    }
-                }
+            } else {
+                self.tests += walk(0..m, out);
             }
         }
 
@@ -933,6 +989,40 @@ mod tests {
                 auto.rebuilds()
             );
         }
+    }
+
+    #[test]
+    fn a_large_level_walked_in_runs_in_parallel_gives_one_walk_s_pairs_in_order() {
+        let mut rng = Rng::new(5);
+        let topo = Topology {
+            min: DVec2::ZERO,
+            max: DVec2::splat(150.0),
+            border: Border::Bounce,
+        };
+        // Equal radii: one level, of more objects than the parallel threshold.
+        let objs = random_objs::<DVec2>(&mut rng, 30_000, 150.0, 0.4, 0.4);
+        let found = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut bp = BroadPhase::new(BroadPhaseMode::Grid);
+            let mut out = Vec::new();
+            pool.install(|| bp.find_pairs(&objs, &topo, &mut out));
+            (bp, out)
+        };
+        let (bp, out) = found(2);
+        assert_eq!(bp.levels_used, 1);
+        let level = &bp.levels[0];
+        assert!(level.cell_runs(RUN_OBJECTS).len() >= 3, "a few runs");
+        let forward = level.offsets(true);
+        let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
+        let mut whole = Vec::new();
+        let tests = level.pairs_within(&topo, &forward, &deltas, 0..objs.len(), &mut whole);
+        assert!(whole.len() > 1000, "{} pairs", whole.len());
+        assert_eq!(out, whole);
+        assert_eq!(bp.tests, tests);
+        assert_eq!(found(1).1, out);
     }
 
     #[test]
