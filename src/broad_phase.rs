@@ -239,6 +239,7 @@ impl<V: Vector> Level<V> {
     /// Appends the pairs of this level's objects in `run` (whole cells of `sorted`) with each
     /// other and with the cells at the `forward` offsets (`deltas` as key offsets); returns the
     /// number of box tests.
+    #[inline]
     fn pairs_within(
         &self,
         topo: &Topology<V>,
@@ -701,8 +702,9 @@ impl<V: Vector> BroadPhase<V> {
         self.levels_used = used.len();
 
         // Pairs within each level: own cell, then the forward half of the neighbours, walking
-        // the occupied cells in order. On a large level, runs of whole cells are walked in
-        // parallel and their pairs joined in order: the same list for any thread count.
+        // the occupied cells in order. On a large level with more than one thread, runs of
+        // whole cells are walked in parallel and their pairs joined in order: the same list as
+        // the one walk, for any thread count.
         for &l in &used {
             let level = &self.levels[l];
             let forward = level.offsets(true);
@@ -711,7 +713,7 @@ impl<V: Vector> BroadPhase<V> {
                 level.pairs_within(topo, &forward, &deltas, run, out)
             };
             let m = level.sorted.len();
-            if m >= crate::world::PARALLEL_MIN {
+            if m >= crate::world::PARALLEL_MIN && rayon::current_num_threads() > 1 {
                 use rayon::prelude::*;
                 let runs = level.cell_runs(RUN_OBJECTS);
                 let parts: Vec<(Vec<(u32, u32)>, u64)> = runs

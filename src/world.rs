@@ -40,7 +40,8 @@ use std::time::{Duration, Instant};
 pub const PARALLEL_MIN: usize = 20_000;
 
 /// Steps with at least this many candidate pairs ask the rules and test the pairs in parallel
-/// chunks of [`INPUT_CHUNK`] pairs (joined in order: the same lists for any thread count).
+/// chunks of [`INPUT_CHUNK`] pairs when there is more than one thread (joined in order: the same
+/// lists for any thread count; on one thread the chunks would only cost their copies).
 const PARALLEL_PAIRS: usize = 2 * INPUT_CHUNK;
 
 /// The settings a world is made with.
@@ -983,7 +984,10 @@ impl<V: Vector> World<V> {
 
     fn stage_rules(&mut self) -> Result<(), Error> {
         self.ruled.clear();
-        if self.candidates.len() >= PARALLEL_PAIRS && self.rules_in_parallel() {
+        if self.candidates.len() >= PARALLEL_PAIRS
+            && rayon::current_num_threads() > 1
+            && self.rules_in_parallel()
+        {
             return Ok(());
         }
         self.rules_in_order()
@@ -1053,7 +1057,10 @@ impl<V: Vector> World<V> {
     fn stage_narrow_phase(&mut self) -> Result<(), Error> {
         self.contacts.clear();
         self.wall_pairs.clear();
-        if self.ruled.len() < PARALLEL_PAIRS || !self.narrow_phase_in_parallel() {
+        if self.ruled.len() < PARALLEL_PAIRS
+            || rayon::current_num_threads() == 1
+            || !self.narrow_phase_in_parallel()
+        {
             self.narrow_phase_in_order()?;
         }
         self.contacts
