@@ -9,7 +9,7 @@ use crate::method::Method;
 use crate::vector::Vector;
 use crate::wall::WallBox;
 use crate::world::{World, WorldConfig};
-use glam::DVec2;
+use glam::{DMat3, DVec2, DVec3};
 
 /// One stress scene.
 pub struct Stress {
@@ -361,6 +361,176 @@ fn glancing(method: Method) -> Result<f64, Error> {
         let err = (got - want)
             .abs()
             .max((right - std::f64::consts::FRAC_PI_2).abs());
+        if !err.is_finite() {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max(err);
+    }
+    Ok(worst)
+}
+
+/// The stress scenes in 3D, with spheres: the 2D ones that carry over unchanged in what they
+/// measure (the bullet is swept over speeds separately: [`bullet_3d`]).
+pub const STRESS_3D: &[Stress] = &[
+    Stress {
+        name: "cradle (3D)",
+        error: "momentum left outside the last ball, relative",
+        run: cradle_3d,
+    },
+    Stress {
+        name: "mass ratios 1e-6..1e6 (3D)",
+        error: "worst relative error in momentum or kinetic energy (inf for NaN)",
+        run: mass_ratios_3d,
+    },
+    Stress {
+        name: "spawned on top (3D)",
+        error: "deepest overlap after 30 steps, in radii (inf for NaN)",
+        run: spawned_on_top_3d,
+    },
+    Stress {
+        name: "glancing hits (3D)",
+        error: "worst angle error of the outgoing velocities against the exact 90 degrees (rad)",
+        run: glancing_3d,
+    },
+];
+
+fn world3(max: DVec3, method: Method) -> Result<World<DVec3>, Error> {
+    World::new(WorldConfig::new(DVec3::ZERO, max).dt(DT).method(method))
+}
+
+/// The bullet in 3D: a sphere of radius 0.05 at `speed` along x towards a plate 0.02 thick
+/// across the whole box, dt = 1/60. True when it ends up past the plate at any step's end.
+pub fn bullet_3d(speed: f64, method: Method) -> Result<bool, Error> {
+    let mut w = world3(DVec3::new(100.0, 10.0, 10.0), method)?;
+    let wall_x = 50.0;
+    w.add_wall(WallBox::cuboid(
+        DVec3::new(wall_x, 5.0, 5.0),
+        DVec3::new(0.02, 10.0, 10.0),
+        DMat3::IDENTITY,
+    )?)?;
+    let b = w.spawn(
+        CritterSpec::ball(DVec3::new(10.0, 5.0, 5.0))
+            .vel(DVec3::new(speed, 0.0, 0.0))
+            .radius(0.05),
+    )?;
+    let steps = ((40.0 / (speed * DT)).ceil() as u64 + 2).min(100_000);
+    for _ in 0..steps {
+        w.step()?;
+        let x = w.get(b).map_or(f64::NAN, |c| c.pos.x);
+        if x >= wall_x || x.is_nan() {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// The slowest bullet speed (of [`bullet_speeds`]) that tunnels through the 3D plate under
+/// `method`, if any.
+pub fn first_tunnelling_speed_3d(method: Method) -> Result<Option<f64>, Error> {
+    for v in bullet_speeds() {
+        if bullet_3d(v, method)? {
+            return Ok(Some(v));
+        }
+    }
+    Ok(None)
+}
+
+fn cradle_3d(method: Method) -> Result<f64, Error> {
+    let r = 0.5;
+    let mut w = world3(DVec3::new(40.0, 4.0, 4.0), method)?;
+    let v0 = 1.0;
+    let mut ids = vec![w.spawn(
+        CritterSpec::ball(DVec3::new(2.0, 2.0, 2.0))
+            .vel(DVec3::new(v0, 0.0, 0.0))
+            .radius(r),
+    )?];
+    for i in 0..5 {
+        let at = DVec3::new(5.0 + 2.0 * r * i as f64, 2.0, 2.0);
+        ids.push(w.spawn(CritterSpec::ball(at).radius(r))?);
+    }
+    w.run(180)?; // 3 s: the striker arrives at 2 s
+    let last = w.get(ids[5]).map_or(f64::NAN, |c| c.vel.x);
+    let others: f64 = ids[..5]
+        .iter()
+        .map(|&id| w.get(id).map_or(f64::NAN, |c| c.vel.length()))
+        .sum();
+    Ok(((last - v0).abs() + others) / v0)
+}
+
+fn mass_ratios_3d(method: Method) -> Result<f64, Error> {
+    let mut worst: f64 = 0.0;
+    let (va, vb) = (DVec3::new(3.0, 0.4, -0.3), DVec3::new(-2.0, 0.0, 0.1));
+    for k in -6..=6 {
+        let ratio = 10f64.powi(k);
+        let mut w = world3(DVec3::new(40.0, 10.0, 10.0), method)?;
+        let a = w.spawn(
+            CritterSpec::ball(DVec3::new(5.0, 5.0, 5.0))
+                .vel(va)
+                .mass(1.0),
+        )?;
+        let b = w.spawn(
+            CritterSpec::ball(DVec3::new(12.0, 5.3, 4.8))
+                .vel(vb)
+                .mass(ratio),
+        )?;
+        let (p0, e0) = (w.momentum(), w.kinetic_energy());
+        w.run(90)?;
+        let (p, e) = (w.momentum(), w.kinetic_energy());
+        let hit = w.get(a).map(|c| c.vel) != Some(va) || w.get(b).map(|c| c.vel) != Some(vb);
+        let pscale = va.length() + vb.length() * ratio;
+        let err = ((p - p0).length() / pscale).max((e - e0).abs() / e0);
+        if !err.is_finite() || !hit {
+            return Ok(f64::INFINITY);
+        }
+        worst = worst.max(err);
+    }
+    Ok(worst)
+}
+
+fn spawned_on_top_3d(method: Method) -> Result<f64, Error> {
+    let mut w = world3(DVec3::splat(20.0), method)?;
+    for i in 0..8 {
+        // Exactly on top of each other, and a hair apart.
+        let off = if i % 2 == 0 { 0.0 } else { 1e-9 * i as f64 };
+        w.spawn(CritterSpec::ball(DVec3::new(10.0 + off, 10.0, 10.0 - off)).radius(0.5))?;
+    }
+    w.run(30)?;
+    let any_nan = w.critters().iter().any(|c| !c.pos.is_finite());
+    Ok(if any_nan {
+        f64::INFINITY
+    } else {
+        max_overlap(&w)
+    })
+}
+
+fn glancing_3d(method: Method) -> Result<f64, Error> {
+    let mut worst: f64 = 0.0;
+    for k in 1..10 {
+        // Impact parameter in diameters, offset along the diagonal of y and z.
+        let b = k as f64 * 0.1;
+        let off = DVec3::new(0.0, 1.0, 1.0).normalize() * b;
+        let mut w = world3(DVec3::splat(60.0), method)?;
+        let a = w.spawn(
+            CritterSpec::ball(DVec3::new(10.0, 30.0, 30.0))
+                .vel(DVec3::new(20.0, 0.0, 0.0))
+                .radius(0.5),
+        )?;
+        let t = w.spawn(CritterSpec::ball(DVec3::new(20.0, 30.0, 30.0) + off).radius(0.5))?;
+        w.run(40)?;
+        let (va, vt) = (w.get(a).map(|c| c.vel), w.get(t).map(|c| c.vel));
+        let (Some(va), Some(vt)) = (va, vt) else {
+            return Ok(f64::INFINITY);
+        };
+        // Exact: the target leaves along the line of centres at contact, at angle asin(b) from
+        // the x axis, in the plane of x and the offset; the striker at right angles to it.
+        let want = b.asin();
+        let got = vt.y.hypot(vt.z).atan2(vt.x);
+        let right = (va.dot(vt) / (va.length() * vt.length())).acos();
+        let out_of_plane = vt.y - vt.z;
+        let err = (got - want)
+            .abs()
+            .max((right - std::f64::consts::FRAC_PI_2).abs())
+            .max((out_of_plane / vt.length()).abs());
         if !err.is_finite() {
             return Ok(f64::INFINITY);
         }

@@ -1,7 +1,10 @@
 //! `critterbox stability`: run the stress scenes under every method and print the table of
-//! `docs/stability.md` (scene x method -> measured error).
+//! `docs/stability.md` (scene x method -> measured error), in 2D and in 3D.
 
-use crate::stability::{first_tunnelling_speed, METHODS, STRESS};
+use crate::method::Method;
+use crate::stability::{
+    first_tunnelling_speed, first_tunnelling_speed_3d, Stress, METHODS, STRESS, STRESS_3D,
+};
 use clap::Args;
 use std::io::Write;
 use std::time::Instant;
@@ -10,24 +13,46 @@ use std::time::Instant;
 #[derive(Args, Debug, Default)]
 pub struct StabilityArgs {}
 
-/// Runs the command.
+/// Runs the command: the 2D table, then the 3D one.
 pub fn run(_args: &StabilityArgs, out: &mut dyn Write) -> anyhow::Result<()> {
+    table(
+        out,
+        "bullet vs wall 0.02 thick, r 0.05, dt 1/60",
+        first_tunnelling_speed,
+        STRESS,
+    )?;
+    writeln!(out)?;
+    table(
+        out,
+        "bullet vs plate 0.02 thick (3D), r 0.05, dt 1/60",
+        first_tunnelling_speed_3d,
+        STRESS_3D,
+    )
+}
+
+/// One table: the bullet's row, then a row per stress scene.
+fn table(
+    out: &mut dyn Write,
+    bullet: &str,
+    first_tunnelling: fn(Method) -> Result<Option<f64>, crate::error::Error>,
+    scenes: &[Stress],
+) -> anyhow::Result<()> {
     let header: Vec<String> = METHODS.iter().map(|m| m.to_string()).collect();
     writeln!(out, "| scene | error | {} |", header.join(" | "))?;
     writeln!(out, "|---|---|{}", "---|".repeat(METHODS.len()))?;
     let mut cells = Vec::new();
     for m in METHODS {
-        cells.push(match first_tunnelling_speed(m)? {
+        cells.push(match first_tunnelling(m)? {
             Some(v) => format!("tunnels from {v:.3e}"),
             None => "never tunnels (to 1e6)".into(),
         });
     }
     writeln!(
         out,
-        "| bullet vs wall 0.02 thick, r 0.05, dt 1/60 | slowest speed that ends past the wall | {} |",
+        "| {bullet} | slowest speed that ends past the wall | {} |",
         cells.join(" | ")
     )?;
-    for s in STRESS {
+    for s in scenes {
         let mut cells = Vec::new();
         for m in METHODS {
             let t = Instant::now();
