@@ -383,6 +383,11 @@ pub const STRESS_3D: &[Stress] = &[
         run: mass_ratios_3d,
     },
     Stress {
+        name: "dense pack 0.5 (3D)",
+        error: "deepest overlap at a step's end, in radii",
+        run: dense_pack_3d,
+    },
+    Stress {
         name: "spawned on top (3D)",
         error: "deepest overlap after 30 steps, in radii (inf for NaN)",
         run: spawned_on_top_3d,
@@ -483,6 +488,49 @@ fn mass_ratios_3d(method: Method) -> Result<f64, Error> {
             return Ok(f64::INFINITY);
         }
         worst = worst.max(err);
+    }
+    Ok(worst)
+}
+
+fn dense_pack_3d(method: Method) -> Result<f64, Error> {
+    // 256 spheres at packing fraction 0.5 in a periodic box: a face-centred cubic lattice, shaken.
+    let cells = 4usize;
+    let r: f64 = 0.5;
+    let phi = 0.5;
+    let volume = (4 * cells.pow(3)) as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) / phi;
+    let l = volume.cbrt();
+    let a = l / cells as f64;
+    let mut w = World::new(
+        WorldConfig::new(DVec3::ZERO, DVec3::splat(l))
+            .border(Border::Wrap)
+            .dt(DT)
+            .method(method)
+            .seed(3),
+    )?;
+    let basis = [
+        DVec3::ZERO,
+        DVec3::new(0.5, 0.5, 0.0),
+        DVec3::new(0.5, 0.0, 0.5),
+        DVec3::new(0.0, 0.5, 0.5),
+    ];
+    for k in 0..cells {
+        for j in 0..cells {
+            for i in 0..cells {
+                for b in basis {
+                    let at = (DVec3::new(i as f64, j as f64, k as f64) + b + 0.25) * a;
+                    let mut v = DVec3::ZERO;
+                    for axis in 0..3 {
+                        v[axis] = w.rng().uniform(-1.0, 1.0);
+                    }
+                    w.spawn(CritterSpec::ball(at).vel(v * 3.0).radius(r))?;
+                }
+            }
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for _ in 0..60 {
+        w.step()?;
+        worst = worst.max(max_overlap(&w));
     }
     Ok(worst)
 }
