@@ -417,7 +417,8 @@ pub const STRESS_3D: &[Stress] = &[
     },
     Stress {
         name: "glancing hits (3D)",
-        error: "worst angle error of the outgoing velocities against the exact 90 degrees (rad)",
+        error:
+            "worst angle error of the outgoing velocities, or part out of the plane of impact (rad)",
         run: glancing_3d,
     },
 ];
