@@ -264,17 +264,40 @@ fn mass_ratios(method: Method) -> Result<f64, Error> {
                 .vel(DVec2::new(-2.0, 0.0))
                 .mass(ratio),
         )?;
-        let (p0, e0) = (w.momentum(), w.kinetic_energy());
-        w.run(90)?;
-        let (p, e) = (w.momentum(), w.kinetic_energy());
-        let hit = w.get(a).map(|c| c.vel) != Some(DVec2::new(3.0, 0.4))
-            || w.get(b).map(|c| c.vel) != Some(DVec2::new(-2.0, 0.0));
-        let pscale = 3.0f64.hypot(0.4) + 2.0 * ratio;
-        let err = ((p - p0).length() / pscale).max((e - e0).abs() / e0);
-        if !err.is_finite() || !hit {
-            return Ok(f64::INFINITY);
-        }
-        worst = worst.max(err);
+        worst = worst.max(two_body_error(w, a, b, ratio)?);
+    }
+    Ok(worst)
+}
+
+/// Runs `w` for 1.5 s, in which `a` (mass 1) and `b` (mass `ratio`) meet once, and measures the
+/// relative error in momentum or kinetic energy: infinite for a NaN, or if they never met.
+fn two_body_error<V: Vector>(
+    mut w: World<V>,
+    a: CritterId,
+    b: CritterId,
+    ratio: f64,
+) -> Result<f64, Error> {
+    let velocity = |w: &World<V>, id| w.get(id).map(|c| c.vel);
+    let (va, vb) = (velocity(&w, a), velocity(&w, b));
+    let pscale = va.map_or(f64::NAN, V::length) + vb.map_or(f64::NAN, V::length) * ratio;
+    let (p0, e0) = (w.momentum(), w.kinetic_energy());
+    w.run(90)?;
+    let (p, e) = (w.momentum(), w.kinetic_energy());
+    let hit = velocity(&w, a) != va || velocity(&w, b) != vb;
+    let err = ((p - p0).length() / pscale).max((e - e0).abs() / e0);
+    Ok(if err.is_finite() && hit {
+        err
+    } else {
+        f64::INFINITY
+    })
+}
+
+/// The deepest overlap at the end of any of 60 steps of `w`, in radii.
+fn deepest_overlap_in_60_steps<V: Vector>(mut w: World<V>) -> Result<f64, Error> {
+    let mut worst: f64 = 0.0;
+    for _ in 0..60 {
+        w.step()?;
+        worst = worst.max(max_overlap(&w));
     }
     Ok(worst)
 }
@@ -304,12 +327,7 @@ fn dense_pack(method: Method) -> Result<f64, Error> {
             w.spawn(CritterSpec::ball(DVec2::new(x, y)).vel(v * 3.0).radius(r))?;
         }
     }
-    let mut worst: f64 = 0.0;
-    for _ in 0..60 {
-        w.step()?;
-        worst = worst.max(max_overlap(&w));
-    }
-    Ok(worst)
+    deepest_overlap_in_60_steps(w)
 }
 
 fn spawned_on_top(method: Method) -> Result<f64, Error> {
@@ -488,16 +506,7 @@ fn mass_ratios_3d(method: Method) -> Result<f64, Error> {
                 .vel(vb)
                 .mass(ratio),
         )?;
-        let (p0, e0) = (w.momentum(), w.kinetic_energy());
-        w.run(90)?;
-        let (p, e) = (w.momentum(), w.kinetic_energy());
-        let hit = w.get(a).map(|c| c.vel) != Some(va) || w.get(b).map(|c| c.vel) != Some(vb);
-        let pscale = va.length() + vb.length() * ratio;
-        let err = ((p - p0).length() / pscale).max((e - e0).abs() / e0);
-        if !err.is_finite() || !hit {
-            return Ok(f64::INFINITY);
-        }
-        worst = worst.max(err);
+        worst = worst.max(two_body_error(w, a, b, ratio)?);
     }
     Ok(worst)
 }
@@ -537,12 +546,7 @@ fn dense_pack_3d(method: Method) -> Result<f64, Error> {
             }
         }
     }
-    let mut worst: f64 = 0.0;
-    for _ in 0..60 {
-        w.step()?;
-        worst = worst.max(max_overlap(&w));
-    }
-    Ok(worst)
+    deepest_overlap_in_60_steps(w)
 }
 
 fn spawned_on_top_3d(method: Method) -> Result<f64, Error> {
