@@ -41,6 +41,9 @@ pub const TC_FRACTION: f64 = 1e-9;
 pub const BUDGET_PER_CRITTER: u64 = 64;
 /// Conservative-advancement iterations before a curved prediction is continued by a recheck.
 const CA_ITERATIONS: usize = 64;
+/// Neighbour shells (straight flights in 3D without walls): the shell's thickness, as a
+/// fraction of the largest diameter. Pairs are listed when their shells overlap.
+pub const SHELL_FRACTION: f64 = 0.6;
 
 const NONE: u32 = u32::MAX;
 const PAIR: u8 = 0;
@@ -48,6 +51,7 @@ const WALL: u8 = 1;
 const BORDER: u8 = 2;
 const CELL: u8 = 3;
 const RECHECK: u8 = 4;
+const SHELL: u8 = 5;
 const BORDER_TAG: u32 = u32::MAX - 16;
 
 #[derive(Clone, Copy, Debug)]
@@ -151,6 +155,10 @@ impl Cells {
         self.data[at] = n as u32 + 1;
     }
 
+    fn clear(&mut self, k: usize) {
+        self.data[k * self.stride] = 0;
+    }
+
     fn remove(&mut self, k: usize, a: u32) {
         let at = k * self.stride;
         let n = self.data[at] as usize;
@@ -188,6 +196,19 @@ pub(crate) struct Scratch<V> {
     cell_walls: Vec<Vec<u32>>,
     /// Some wall is alive (otherwise `cell_walls` is not read).
     has_walls: bool,
+    /// Neighbour shells instead of cell crossings (Smallenburg's scheme): the cells hold each
+    /// critter by its shell's centre, `near` lists the critters whose shells overlap, and
+    /// leaving the shell is the event that lists again.
+    shells: bool,
+    /// The shell's thickness: a critter stays within `shell / 2` of its shell's centre.
+    shell: f64,
+    /// Cells only, even where shells would pay (tests compare the two).
+    #[cfg(test)]
+    no_shells: bool,
+    /// Each critter's shell centre (its position when it was last listed).
+    center: Vec<V>,
+    /// Each critter's neighbours (`near.members(a)`), symmetric.
+    near: Cells,
     /// Each critter's next event.
     heap: Queue<Ev>,
     /// The earliest event found so far by the running `predict_all`.
@@ -323,6 +344,11 @@ fn run_with<V: Vector>(
                 refresh(w, sc, ev.a);
                 predict_after_crossing(w, sc, ev.a, ev.b, t)?;
             }
+            SHELL => {
+                advance(w, sc, ev.a, t);
+                list_again(w, sc, ev.a);
+                predict_all(w, sc, ev.a, t)?;
+            }
             _ => {
                 // RECHECK: continue a curved prediction that did not settle.
                 predict_all(w, sc, ev.a, t)?;
@@ -391,10 +417,21 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     sc.predictions = 0;
     sc.pair_tests = 0;
     sc.budget = BUDGET_PER_CRITTER * disks as u64 + 10_000;
-    // Cells at least one diameter wide, at most about 2 per disk.
+    // Shells pay where a cell's neighbourhood is large (27 cells) and flights are lines.
+    sc.shells = sc.straight && !sc.has_walls && V::DIM == 3 && disks > 0;
+    #[cfg(test)]
+    {
+        sc.shells &= !sc.no_shells;
+    }
+    sc.shell = if sc.shells {
+        SHELL_FRACTION * 2.0 * rmax
+    } else {
+        0.0
+    };
+    // Cells at least one diameter (and a shell) wide, at most about 2 per disk.
     let size = w.topo.size();
     let dim = V::DIM;
-    let want = (2.0 * rmax * (1.0 + 1e-9)).max(f64::MIN_POSITIVE);
+    let want = (2.0 * rmax * (1.0 + 1e-9) + sc.shell * (1.0 + 1e-9)).max(f64::MIN_POSITIVE);
     let mut dims = [1usize; 3];
     for axis in 0..dim {
         dims[axis] = ((size.get(axis) / want).floor() as usize).clamp(1, 1 << 20);
@@ -493,6 +530,151 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
                 }
             }
         }
+    }
+    if sc.shells {
+        list_all(w, sc);
+    }
+}
+
+/// Lists every pair whose shells overlap (at the start of a flight, every shell is centred on
+/// its critter).
+fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
+    let n = sc.body.len();
+    sc.center.clear();
+    sc.center.extend(sc.body.iter().map(|b| b.pos));
+    // Room for the neighbours a random fluid at close packing would give, and some.
+    sc.near.reset(n, 24);
+    let mut around = [0usize; 27];
+    for a in 0..n as u32 {
+        if sc.body[a as usize].radius.is_nan() {
+            continue;
+        }
+        let count = cells_around(w, sc, a, &mut around);
+        for &k in &around[..count] {
+            for i in 0..sc.cells.members(k).len() {
+                let b = sc.cells.members(k)[i];
+                if b > a && shells_overlap(w, sc, a, b) {
+                    sc.near.push(a as usize, b);
+                    sc.near.push(b as usize, a);
+                }
+            }
+        }
+    }
+}
+
+/// Whether the shells of `a` and `b` (a live disk) overlap: only such pairs can touch before
+/// one of them leaves its shell.
+#[inline]
+fn shells_overlap<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, b: u32) -> bool {
+    let rb = sc.body[b as usize].radius;
+    if rb.is_nan() {
+        return false;
+    }
+    let reach = (sc.body[a as usize].radius + rb + sc.shell) * (1.0 + 1e-9);
+    w.topo
+        .delta(sc.center[a as usize], sc.center[b as usize])
+        .length_squared()
+        < reach * reach
+}
+
+/// The keys of the cells around `a`'s cell (its own included), each once; their number.
+fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usize; 27]) -> usize {
+    let home = sc.cell[a as usize] as usize;
+    if interior::<V>(sc, a) {
+        for (o, k) in sc.offsets.iter().zip(out.iter_mut()) {
+            *k = (home as isize + o) as usize;
+        }
+        return sc.offsets.len();
+    }
+    let dims = sc.dims;
+    let hc = sc.coord[a as usize];
+    let mut count = 0;
+    let reach = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
+    for dz in reach(2) {
+        for dy in reach(1) {
+            for dx in reach(0) {
+                let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
+                if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
+                {
+                    continue;
+                }
+                let k = key(&dims, cc);
+                if !out[..count].contains(&k) {
+                    out[count] = k;
+                    count += 1;
+                }
+            }
+        }
+    }
+    count
+}
+
+/// Lists `a` again, centring its shell on where it is now (its body holds now): it leaves its
+/// old neighbours' lists, moves to the cell of its new centre, and lists the critters whose
+/// shells overlap the new one. Its flight is unchanged, so no event is made stale.
+fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
+    let ai = a as usize;
+    // The old neighbours keep `a` in their lists until they list again themselves: a pair
+    // test too many costs less than finding `a` in every old list.
+    sc.near.clear(ai);
+    let old = sc.cell[ai] as usize;
+    if sc.body[ai].radius.is_nan() {
+        sc.cells.remove(old, a);
+        return;
+    }
+    let mut p = sc.body[ai].pos;
+    if w.topo.wraps() {
+        let q = w.topo.wrap_position(p);
+        if q != p {
+            p = q;
+            sc.body[ai].pos = p;
+            if let Some(c) = w.critters.slot_mut_moving(a) {
+                c.pos = p;
+            }
+        }
+    }
+    sc.center[ai] = p;
+    let new = cell_of(w, sc, p);
+    move_cell(sc, a, old, new);
+    let mut around = [0usize; 27];
+    let count = cells_around(w, sc, a, &mut around);
+    for &k in &around[..count] {
+        for i in 0..sc.cells.members(k).len() {
+            let b = sc.cells.members(k)[i];
+            if b != a && shells_overlap(w, sc, a, b) {
+                sc.near.push(ai, b);
+                if !sc.near.members(b as usize).contains(&a) {
+                    sc.near.push(b as usize, a);
+                }
+            }
+        }
+    }
+}
+
+/// When straight-flying `a` (`mine`: its position and velocity at `t`) leaves its shell.
+#[inline]
+fn predict_shell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64, mine: (V, V, V)) {
+    let (p, v, _) = mine;
+    let d = w.topo.delta(sc.center[a as usize], p);
+    let h = 0.5 * sc.shell;
+    let c = d.length_squared() - h * h;
+    let s = if c >= 0.0 {
+        0.0
+    } else {
+        let (qa, qb) = (v.length_squared(), d.dot(v));
+        if qa == 0.0 {
+            return;
+        }
+        // The positive root; c < 0, so -c / (b + sqrt(disc)) when b > 0 avoids cancellation.
+        let root = (qb * qb - qa * c).sqrt();
+        if qb > 0.0 {
+            -c / (qb + root)
+        } else {
+            (root - qb) / qa
+        }
+    };
+    if t + s <= sc.t_end {
+        push(sc, t + s, a, 0, SHELL);
     }
 }
 
@@ -669,7 +851,12 @@ fn predict_all<V: Vector>(
     sc.predictions += 1;
     let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
-    if interior::<V>(sc, a) {
+    if sc.shells {
+        for i in 0..sc.near.members(a as usize).len() {
+            let b = sc.near.members(a as usize)[i];
+            predict_disk(w, sc, a, b, t, mine)?;
+        }
+    } else if interior::<V>(sc, a) {
         // The common case: the neighbours are fixed offsets away, no wrapping, no repeats.
         for i in 0..sc.offsets.len() {
             let k = (home as isize + sc.offsets[i]) as usize;
@@ -699,7 +886,9 @@ fn finish_prediction<V: Vector>(
     }
     sc.best[a as usize] = sc.cand;
     predict_border(w, sc, a, t, mine);
-    if sc.straight {
+    if sc.shells {
+        predict_shell(w, sc, a, t, mine);
+    } else if sc.straight {
         predict_cell_straight(w, sc, a, t, mine);
     } else {
         predict_cell(w, sc, a, t);
@@ -1191,6 +1380,19 @@ fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize) {
 
 /// After a hook ran: the critter may have died or been moved; put it in the right cell.
 fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
+    if sc.shells {
+        // Listed again when it died, grew, or was moved out of its shell.
+        let stays = w.critters.slot(a).is_some_and(|c| {
+            c.alive
+                && c.radius == sc.body[a as usize].radius
+                && w.topo.delta(sc.center[a as usize], c.pos).length() <= 0.5 * sc.shell
+        });
+        if !stays {
+            refresh(w, sc, a);
+            list_again(w, sc, a);
+        }
+        return;
+    }
     let old = sc.cell[a as usize] as usize;
     let Some(c) = w.critters.slot(a) else { return };
     if !c.alive {
@@ -1272,5 +1474,87 @@ impl<V: Vector> World<V> {
     /// collisions of contact distance x impulse (for pressure, `docs/methods.md`).
     pub fn collision_virial(&self) -> f64 {
         self.flight.virial
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scenes::{gas, GasParams};
+    use crate::{Border, Method, World};
+    use glam::DVec3;
+
+    fn periodic_gas(no_shells: bool) -> World<DVec3> {
+        let mut w = gas::<DVec3>(&GasParams {
+            n: 512,
+            packing: 0.35,
+            dt: 0.5,
+            border: Border::Wrap,
+            ..GasParams::default()
+        })
+        .expect("the gas builds");
+        w.set_method(Method::Event).expect("event");
+        w.flight.no_shells = no_shells;
+        w
+    }
+
+    /// Shells and cells are two ways of finding the same collisions: over a few collisions per
+    /// sphere (before round-off differences grow chaotically) they find the same number and
+    /// leave every sphere in the same place.
+    #[test]
+    fn shells_and_cells_find_the_same_collisions() {
+        let (mut shells, mut cells) = (periodic_gas(false), periodic_gas(true));
+        let (mut with_shells, mut with_cells) = (0, 0);
+        for _ in 0..2 {
+            shells.step().expect("steps");
+            cells.step().expect("steps");
+            with_shells += shells.stats().impacts;
+            with_cells += cells.stats().impacts;
+        }
+        assert!(
+            shells.flight.shells,
+            "the 3D periodic gas lists neighbours in shells"
+        );
+        assert!(!cells.flight.shells);
+        assert!(
+            with_cells > 2 * 512,
+            "{with_cells} collisions: too few to compare"
+        );
+        assert_eq!(with_shells, with_cells);
+        let topo = shells.topo;
+        let worst = shells
+            .critters()
+            .iter()
+            .zip(cells.critters().iter())
+            .map(|(a, b)| topo.delta(a.pos, b.pos).length())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "spheres differ by {worst:e}");
+    }
+
+    /// Shells keep the gas exact: energy and momentum conserved, nobody overlapping.
+    #[test]
+    fn shells_conserve_energy_and_momentum_and_leave_no_overlap() {
+        let mut w = periodic_gas(false);
+        let e0 = w.kinetic_energy();
+        let p0: DVec3 = w.critters().iter().map(|c| c.vel * c.mass).sum();
+        let mut impacts = 0;
+        for _ in 0..6 {
+            w.step().expect("steps");
+            impacts += w.stats().impacts;
+        }
+        assert!(impacts > 5 * 512, "{impacts} collisions");
+        let e1 = w.kinetic_energy();
+        let p1: DVec3 = w.critters().iter().map(|c| c.vel * c.mass).sum();
+        assert!(((e1 - e0) / e0).abs() < 1e-12, "energy {e0} -> {e1}");
+        assert!(
+            (p1 - p0).length() < 1e-9 * e0.sqrt(),
+            "momentum {p0} -> {p1}"
+        );
+        let all: Vec<_> = w.critters().iter().collect();
+        for (i, a) in all.iter().enumerate() {
+            for b in &all[i + 1..] {
+                let gap = w.topo.delta(a.pos, b.pos).length() - a.radius - b.radius;
+                assert!(gap > -1e-9, "overlap {gap:e}");
+            }
+        }
     }
 }
