@@ -760,6 +760,12 @@ impl<V: Vector> World<V> {
         match method {
             Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
             Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
+            Method::Swept
+                if self.method == Method::Auto
+                    && crate::method::auto::packing(self) < crate::method::auto::SPARSE =>
+            {
+                crate::method::swept::step_where_needed(self, &mut stats)?
+            }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
         }

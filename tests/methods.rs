@@ -415,3 +415,66 @@ fn event_ball_bouncing_on_the_border_under_gravity_keeps_its_parabola() {
         assert!((c.pos.y - y).abs() < 1e-7, "t {t}: {} vs {y}", c.pos.y);
     }
 }
+
+/// A bullet at 600 (36 radii per step) strikes an equal disk at rest in a field of 360 slow
+/// disks, both heading for a wall 0.02 thick; `method` runs the scene. Returns the two disks'
+/// velocities after the step of the strike, the largest x any disk reached, and the flight's
+/// predictions summed over the run.
+fn bullet_among_slow_disks(method: Method) -> (DVec2, DVec2, f64, usize) {
+    let config = WorldConfig::new(DVec2::ZERO, DVec2::new(100.0, 10.0))
+        .dt(1.0 / 60.0)
+        .method(method);
+    let mut w = World::new(config).unwrap();
+    w.add_wall(WallBox::segment(DVec2::new(50.0, 0.0), DVec2::new(50.0, 10.0), 0.02).unwrap())
+        .unwrap();
+    let ball = |p: DVec2, v: DVec2| CritterSpec::ball(p).vel(v).radius(0.05).restitution(1.0);
+    let bullet = w
+        .spawn(ball(DVec2::new(10.0, 5.0), DVec2::new(600.0, 0.0)))
+        .unwrap();
+    let target = w.spawn(ball(DVec2::new(30.0, 5.0), DVec2::ZERO)).unwrap();
+    // Rows at y = 0.5, 1.5, ..., 9.5 (none on the bullet's line), drifting at 0.3 per second.
+    for i in 0..36 {
+        for j in 0..10 {
+            let p = DVec2::new(12.0 + i as f64, 0.5 + j as f64);
+            let v = DVec2::new(if (i + j) % 2 == 0 { 0.3 } else { -0.3 }, 0.0);
+            w.spawn(ball(p, v)).unwrap();
+        }
+    }
+    let (mut after, mut furthest, mut predictions) = (None, 0.0f64, 0);
+    for _ in 0..120 {
+        w.step().unwrap();
+        predictions += w.stats().candidates;
+        let v = |id| w.get(id).unwrap().vel;
+        if after.is_none() && v(target).x != 0.0 {
+            after = Some((v(bullet), v(target)));
+        }
+        for c in w.critters().iter().filter(|c| !c.is_wall()) {
+            furthest = furthest.max(c.pos.x);
+        }
+    }
+    let (vb, vt) = after.expect("the bullet struck");
+    (vb, vt, furthest, predictions)
+}
+
+#[test]
+fn auto_sweeps_only_the_fast_critters_and_neither_tunnels() {
+    let (sb, st, s_far, s_cost) = bullet_among_slow_disks(Method::Swept);
+    let (ab, at, a_far, a_cost) = bullet_among_slow_disks(Method::Auto);
+    for (method, vb, vt, far) in [("swept", sb, st, s_far), ("auto", ab, at, a_far)] {
+        // Equal masses, head on, e = 1: the bullet stops and the target leaves at 600.
+        assert!(vb.length() < 1e-9, "{method}: bullet left with {vb}");
+        assert!(
+            (vt - DVec2::new(600.0, 0.0)).length() < 1e-9,
+            "{method}: target {vt}"
+        );
+        // The struck disk, now the fast one, bounces off the wall instead of passing it.
+        assert!(far < 50.0, "{method}: a disk reached x = {far}");
+    }
+    // Swept predicts for all 362 disks every step; auto only for the fast disk of the step (its
+    // strike and its cell crossings), well under a tenth of that.
+    assert!(s_cost > 120 * 362, "swept made {s_cost} predictions");
+    assert!(
+        a_cost * 10 < s_cost,
+        "auto made {a_cost} predictions, swept {s_cost}"
+    );
+}

@@ -17,7 +17,7 @@ use crate::world::{StepStats, World};
 pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
     let clock = std::time::Instant::now();
     let g = world.gravity;
-    let complete = crate::method::flight::run(world, g, world.dt, stats)?;
+    let complete = crate::method::flight::run(world, g, world.dt, None, stats)?;
     stats.response += clock.elapsed();
     if !complete {
         stats.budget_exceeded += 1;

@@ -6,7 +6,8 @@
 //!   impact resolved in time order, then a discrete pass for resting contacts. No tunnelling.
 //! * [`Method::Event`]: exact event-driven dynamics ([`event`]): parabolic flights under gravity,
 //!   collisions, wall hits, border and cell crossings processed in time order.
-//! * [`Method::Auto`]: picks one of the above per step from the scene's speeds ([`auto`]).
+//! * [`Method::Auto`]: discrete or swept per step from the scene's speeds, and within a swept
+//!   step predictions only for the critters that are fast or may meet something ([`auto`]).
 //!
 //! Every method keeps Pop's roles: a touching pair is handed to the caller's `collide` hook.
 //! [`flight`] is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
@@ -34,7 +35,7 @@ pub enum Method {
     Swept,
     /// Exact event-driven dynamics.
     Event,
-    /// The cheapest method that keeps the tolerances, chosen each step.
+    /// The cheapest method that keeps the tolerances, chosen each step and per critter.
     Auto,
 }
 

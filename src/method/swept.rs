@@ -42,10 +42,44 @@ pub fn motion_scale<V: Vector>(world: &World<V>) -> (f64, f64) {
     (fastest, smallest)
 }
 
+/// How many live disks move more than `limit` in the coming step, and how many there are.
+pub fn count_fast<V: Vector>(world: &World<V>, limit: f64) -> (usize, usize) {
+    let (g, dt) = (world.gravity, world.dt);
+    let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let (mut fast, mut all) = (0, 0);
+    for c in disks {
+        let v = if c.fixed { c.vel } else { c.vel + g * dt };
+        fast += usize::from(v.length() * dt > limit);
+        all += 1;
+    }
+    (fast, all)
+}
+
 /// One swept step (after the update hooks, before the lifecycle).
 pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
+    sweep(world, stats, false)
+}
+
+/// The swept step as `auto` takes it: the same events, but a slow critter (moving less than
+/// [`SWEEP_FRACTION`] of the smallest radius or wall thickness) that can meet nothing along its
+/// line this step (no disk, wall or border within reach of both) makes no prediction; it joins
+/// in when a collision changes its flight. A few bullets among many spread-out slow critters
+/// then cost the bullets' predictions, not everyone's.
+pub fn step_where_needed<V: Vector>(
+    world: &mut World<V>,
+    stats: &mut StepStats,
+) -> Result<(), Error> {
+    sweep(world, stats, true)
+}
+
+fn sweep<V: Vector>(
+    world: &mut World<V>,
+    stats: &mut StepStats,
+    fast_only: bool,
+) -> Result<(), Error> {
     let (fastest, smallest) = motion_scale(world);
-    if fastest <= SWEEP_FRACTION * smallest {
+    let limit = SWEEP_FRACTION * smallest;
+    if fastest <= limit {
         return world.discrete_substeps(1, stats);
     }
     let clock = std::time::Instant::now();
@@ -55,7 +89,8 @@ pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<()
             c.vel += dv;
         }
     }
-    let complete = crate::method::flight::run(world, V::zero(), world.dt, stats)?;
+    let fast = fast_only.then_some(limit);
+    let complete = crate::method::flight::run(world, V::zero(), world.dt, fast, stats)?;
     if !complete {
         stats.budget_exceeded += 1;
     }
