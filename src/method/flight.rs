@@ -655,7 +655,9 @@ fn shells_overlap<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, b: u32) -> b
         < reach * reach
 }
 
-/// The keys of the cells around `a`'s cell (its own included), each once; their number.
+/// The keys of the cells around `a`'s cell (its own included), each once (at the grid's edges
+/// they are wrapped or cut at the border, and with fewer than three cells along an axis they
+/// repeat); their number.
 fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usize; 27]) -> usize {
     let home = sc.cell[a as usize] as usize;
     if interior::<V>(sc, a) {
@@ -1084,32 +1086,10 @@ fn scan_edge_neighbours<V: Vector>(
     t: f64,
     mine: (V, V, V),
 ) -> Result<(), Error> {
-    let dims = sc.dims;
-    let hc = sc.coord[a as usize];
-    let small = dims[..V::DIM].iter().any(|&n| n < 3);
-    let mut seen = [usize::MAX; 27];
-    let mut nseen = 0;
-    let reach = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
-    for dz in reach(2) {
-        for dy in reach(1) {
-            for dx in reach(0) {
-                let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
-                if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
-                {
-                    continue;
-                }
-                let k = key(&dims, cc);
-                if small {
-                    // Fewer than three cells along an axis: neighbours repeat.
-                    if seen[..nseen].contains(&k) {
-                        continue;
-                    }
-                    seen[nseen] = k;
-                    nseen += 1;
-                }
-                scan_cell(w, sc, a, k, t, mine)?;
-            }
-        }
+    let mut around = [0usize; 27];
+    let count = cells_around(w, sc, a, &mut around);
+    for &k in &around[..count] {
+        scan_cell(w, sc, a, k, t, mine)?;
     }
     Ok(())
 }
