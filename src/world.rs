@@ -749,21 +749,20 @@ impl<V: Vector> World<V> {
         let clock = Instant::now();
         self.stage_update()?;
         stats.update = clock.elapsed();
+        let mut per_critter = false;
         let method = match self.method {
             Method::Auto => {
-                let (m, why) = crate::method::auto::choose(self);
-                self.auto_choice = Some((m, why));
-                m
+                let choice = crate::method::auto::choose(self);
+                per_critter = choice.per_critter;
+                self.auto_choice = Some((choice.method, choice.why));
+                choice.method
             }
             m => m,
         };
         match method {
             Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
             Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
-            Method::Swept
-                if self.method == Method::Auto
-                    && crate::method::auto::packing(self) < crate::method::auto::SPARSE =>
-            {
+            Method::Swept if per_critter => {
                 crate::method::swept::step_where_needed(self, &mut stats)?
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,

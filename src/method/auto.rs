@@ -34,30 +34,43 @@ pub fn packing<V: Vector>(world: &World<V>) -> f64 {
     covered / volume
 }
 
+/// What `auto` takes for the coming step.
+pub struct Choice {
+    /// Discrete or swept.
+    pub method: Method,
+    /// A swept step taken per critter (a sparse scene).
+    pub per_critter: bool,
+    /// Why, for `critterbox run`.
+    pub why: String,
+}
+
 /// The method for the coming step and why.
-pub fn choose<V: Vector>(world: &World<V>) -> (Method, String) {
+pub fn choose<V: Vector>(world: &World<V>) -> Choice {
     let (fastest, smallest) = motion_scale(world);
     let limit = SWEEP_FRACTION * smallest;
     if fastest <= limit {
-        (
-            Method::Discrete,
-            format!(
+        Choice {
+            method: Method::Discrete,
+            per_critter: false,
+            why: format!(
                 "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
             ),
-        )
+        }
     } else {
         let (fast, all) = count_fast(world, limit);
         let phi = packing(world);
-        let slow = if phi < SPARSE {
+        let per_critter = phi < SPARSE;
+        let slow = if per_critter {
             format!("the disks cover {phi:.3} of the box (under {SPARSE}), so the slow ones are swept only where something is within reach")
         } else {
             format!("the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone is swept")
         };
-        (
-            Method::Swept,
-            format!(
+        Choice {
+            method: Method::Swept,
+            per_critter,
+            why: format!(
                 "swept: the fastest critter moves {fastest:.3e} per step, more than {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete could tunnel; {fast} of {all} critters move that far; {slow}"
             ),
-        )
+        }
     }
 }

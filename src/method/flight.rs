@@ -669,10 +669,10 @@ fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usi
     let dims = sc.dims;
     let hc = sc.coord[a as usize];
     let mut count = 0;
-    let reach = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
-    for dz in reach(2) {
-        for dy in reach(1) {
-            for dx in reach(0) {
+    let span = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
+    for dz in span(2) {
+        for dy in span(1) {
+            for dx in span(0) {
                 let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
                 if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
                 {
@@ -689,9 +689,9 @@ fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usi
     count
 }
 
-/// Lists `a` again, centring its shell on where it is now (its body holds now): it leaves its
-/// old neighbours' lists, moves to the cell of its new centre, and lists the critters whose
-/// shells overlap the new one. Its flight is unchanged, so no event is made stale.
+/// Lists `a` again, centring its shell on where it is now (its body holds now): it empties its
+/// list, moves to the cell of its new centre, and lists the critters whose shells overlap the
+/// new one (and joins their lists). Its flight is unchanged, so no event is made stale.
 fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     let ai = a as usize;
     // The old neighbours keep `a` in their lists until they list again themselves: a pair

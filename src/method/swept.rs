@@ -19,10 +19,16 @@ use crate::world::{StepStats, World};
 /// or wall thickness.
 pub const SWEEP_FRACTION: f64 = 0.25;
 
+/// How far disk `c` moves in the coming step (the free ones after gravity's kick).
+fn displacement<V: Vector>(world: &World<V>, c: &crate::critter::Critter<V>) -> f64 {
+    let (g, dt) = (world.gravity, world.dt);
+    let v = if c.fixed { c.vel } else { c.vel + g * dt };
+    v.length() * dt
+}
+
 /// The largest displacement of a critter in the coming step, and the smallest length it must be
 /// compared with (smallest disk radius, thinnest wall).
 pub fn motion_scale<V: Vector>(world: &World<V>) -> (f64, f64) {
-    let (g, dt) = (world.gravity, world.dt);
     let mut fastest: f64 = 0.0;
     let mut smallest = f64::INFINITY;
     for c in world.critters.iter().filter(|c| c.alive) {
@@ -34,8 +40,7 @@ pub fn motion_scale<V: Vector>(world: &World<V>) -> (f64, f64) {
             }
             None => {
                 smallest = smallest.min(c.radius);
-                let v = if c.fixed { c.vel } else { c.vel + g * dt };
-                fastest = fastest.max(v.length() * dt);
+                fastest = fastest.max(displacement(world, c));
             }
         }
     }
@@ -44,12 +49,10 @@ pub fn motion_scale<V: Vector>(world: &World<V>) -> (f64, f64) {
 
 /// How many live disks move more than `limit` in the coming step, and how many there are.
 pub fn count_fast<V: Vector>(world: &World<V>, limit: f64) -> (usize, usize) {
-    let (g, dt) = (world.gravity, world.dt);
     let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
     let (mut fast, mut all) = (0, 0);
     for c in disks {
-        let v = if c.fixed { c.vel } else { c.vel + g * dt };
-        fast += usize::from(v.length() * dt > limit);
+        fast += usize::from(displacement(world, c) > limit);
         all += 1;
     }
     (fast, all)
