@@ -32,6 +32,9 @@ pub trait Vector:
     /// What aligns a [`crate::critter::Critter`] of this dimension (a zero-length array of it is
     /// one of its fields): 64 bytes in 2D, so a critter's hot fields share one cache line.
     type CritterAlign: Clone + Copy + Debug + Send + Sync;
+    /// The same number of components in single precision, for compact copies (the broad phase's
+    /// bounds of the Verlet list).
+    type Single: Clone + Copy + Debug + Default + Send + Sync + AsRef<[f32]> + AsMut<[f32]>;
 
     /// The zero vector.
     fn zero() -> Self;
@@ -79,6 +82,7 @@ impl Vector for DVec2 {
     const DIM: usize = 2;
     type Frame = DVec2;
     type CritterAlign = Align64;
+    type Single = [f32; 2];
 
     #[inline]
     fn zero() -> Self {
@@ -133,6 +137,7 @@ impl Vector for DVec3 {
     const DIM: usize = 3;
     type Frame = DMat3;
     type CritterAlign = u64;
+    type Single = [f32; 3];
 
     #[inline]
     fn zero() -> Self {
