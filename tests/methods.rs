@@ -478,3 +478,92 @@ fn auto_sweeps_only_the_fast_critters_and_neither_tunnels() {
         "auto made {a_cost} predictions, swept {s_cost}"
     );
 }
+
+/// A collide hook that grows its critter to radius 2 on its first collision, moving it back so
+/// that it still only touches what it hit.
+struct Grower;
+
+impl critterbox::KindHooks<DVec2> for Grower {
+    fn collide(
+        &self,
+        ctx: &mut critterbox::CollideCtx<'_, DVec2>,
+    ) -> Result<bool, critterbox::Error> {
+        let hit = ctx.collide_default();
+        let me = ctx.me_mut();
+        if me.radius() < 1.0 {
+            let r = me.radius();
+            me.set_radius(2.0)?;
+            me.pos.x += 2.0 - r;
+        }
+        Ok(hit)
+    }
+}
+
+/// The grower (radius 0.25, moving left at 1) strikes a resting ball at t = 1.5 s, stops, and
+/// grows to radius 2 in its hook; a third ball, coming left at 1 from far away, meets the grown
+/// disk at t = 7.5 s at x = 12.5 and (equal masses, head on, e = 1) stops there while the grower
+/// leaves at -1, to x = 8.75 at t = 9 s. The
+/// whole run is one step of 9 s, so the flight's cells were sized for radius 0.25 and the grown
+/// disk reaches across many of them.
+fn grown_disk_is_met(method: Method) -> (DVec2, DVec2, DVec2, DVec2) {
+    let config = WorldConfig::new(DVec2::ZERO, DVec2::new(40.0, 40.0))
+        .dt(9.0)
+        .method(method);
+    let mut w = World::new(config).unwrap();
+    let defaults = critterbox::KindDefaults {
+        priority: critterbox::CP_PLAYER,
+        ..critterbox::KindDefaults::default()
+    };
+    w.register_kind("grower", None, defaults, std::rc::Rc::new(Grower))
+        .unwrap();
+    let ball = |p: DVec2, v: DVec2| CritterSpec::ball(p).vel(v).radius(0.25).restitution(1.0);
+    let grower = w
+        .spawn(
+            CritterSpec::new("grower", DVec2::new(10.0, 30.0))
+                .vel(DVec2::new(-1.0, 0.0))
+                .radius(0.25)
+                .restitution(1.0),
+        )
+        .unwrap();
+    w.spawn(ball(DVec2::new(8.0, 30.0), DVec2::ZERO)).unwrap();
+    let third = w
+        .spawn(ball(DVec2::new(20.0, 30.0), DVec2::new(-1.0, 0.0)))
+        .unwrap();
+    // A resting crowd below, so the flight's cells are small and many (about one unit wide).
+    for i in 0..30 {
+        for j in 0..30 {
+            w.spawn(ball(
+                DVec2::new(2.0 + 0.6 * i as f64, 2.0 + 0.6 * j as f64),
+                DVec2::ZERO,
+            ))
+            .unwrap();
+        }
+    }
+    w.step().unwrap();
+    let (g, t) = (w.get(grower).unwrap(), w.get(third).unwrap());
+    (g.pos, t.pos, g.vel, t.vel)
+}
+
+#[test]
+fn a_disk_grown_by_its_hook_is_met_by_every_method_that_never_misses() {
+    for method in [Method::Swept, Method::Event, Method::Auto] {
+        let (pg, pt, vg, vt) = grown_disk_is_met(method);
+        // Met late, the third ball would have gone into the grown disk before stopping.
+        assert!(
+            (pt - DVec2::new(12.5, 30.0)).length() < 1e-9,
+            "{method:?}: the third ball stopped at {pt}"
+        );
+        assert!(
+            (pg - DVec2::new(8.75, 30.0)).length() < 1e-9,
+            "{method:?}: the grower is at {pg}"
+        );
+        assert!(
+            (vg - DVec2::new(-1.0, 0.0)).length() < 1e-9,
+            "{method:?}: the grower left with {vg}"
+        );
+        assert!(
+            vt.length() < 1e-9,
+            "{method:?}: the third ball left with {vt}"
+        );
+    }
+}

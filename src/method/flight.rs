@@ -207,6 +207,10 @@ pub(crate) struct Scratch<V> {
     shells: bool,
     /// The shell's thickness: a critter stays within `shell / 2` of its shell's centre.
     shell: f64,
+    /// The largest radius the cells and shells are sized for.
+    rmax: f64,
+    /// At least this `rmax` (set when a hook grew a critter beyond the last flight's).
+    least_rmax: f64,
     /// Slower critters predict at the flight's start only if they may meet something (`run`).
     fast: Option<f64>,
     /// Cells only, even where shells would pay (tests compare the two).
@@ -267,6 +271,9 @@ pub(crate) fn run<V: Vector>(
     out
 }
 
+/// Flies the critters to `t_end`, in one flight unless a hook grows a critter beyond the largest
+/// radius the flight's cells (or shells) were sized for: the flight then stops there, everyone
+/// is brought to that time, and a new flight, sized for the grown critter, flies the rest.
 fn run_with<V: Vector>(
     w: &mut World<V>,
     sc: &mut Scratch<V>,
@@ -274,6 +281,34 @@ fn run_with<V: Vector>(
     t_end: f64,
     stats: &mut StepStats,
 ) -> Result<bool, Error> {
+    sc.least_rmax = 0.0;
+    let (mut flown, mut virial) = (0.0, 0.0);
+    loop {
+        let outcome = fly(w, sc, acc, t_end - flown, stats);
+        virial += sc.virial;
+        sc.virial = virial;
+        match outcome? {
+            Flight::Done(complete) => return Ok(complete),
+            Flight::Grown(t) => flown += t,
+        }
+    }
+}
+
+/// How a flight ended.
+enum Flight {
+    /// At its end; false when the event budget ran out.
+    Done(bool),
+    /// At this time, because a hook grew a critter beyond what the cells were sized for.
+    Grown(f64),
+}
+
+fn fly<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    t_end: f64,
+    stats: &mut StepStats,
+) -> Result<Flight, Error> {
     setup(w, sc, acc, t_end);
     let n = w.critters.slot_count() as u32;
     for a in 0..n {
@@ -286,6 +321,7 @@ fn run_with<V: Vector>(
     }
     let mut processed = 0u64;
     let mut complete = true;
+    let mut grown = None;
     // Every branch below predicts the event's owner again (which replaces the event in the
     // queue) or removes the event.
     while let Some(ev) = sc.heap.peek() {
@@ -345,6 +381,16 @@ fn run_with<V: Vector>(
                         refresh(w, sc, x);
                     }
                 }
+                // A radius (NaN for walls and the dead) beyond what the cells were sized for:
+                // neighbours it now reaches may lie outside the cells it scans. Cells sized for
+                // twice the new radius make many restarts in one flight unlikely.
+                let radius = |x: u32| sc.body[x as usize].radius;
+                let largest = radius(ev.a).max(radius(ev.b));
+                if largest > sc.rmax {
+                    sc.least_rmax = 2.0 * largest;
+                    grown = Some(t);
+                    break;
+                }
                 for x in [ev.a, ev.b] {
                     predict_all(w, sc, x, t)?;
                 }
@@ -377,9 +423,10 @@ fn run_with<V: Vector>(
     stats.pair_tests += sc.pair_tests;
     stats.candidates += sc.predictions as usize;
     // Everyone to the end of the flight.
+    let end = grown.unwrap_or(t_end);
     let topo = w.topo;
     for a in 0..n {
-        advance(w, sc, a, t_end);
+        advance(w, sc, a, end);
         if let Some(c) = w.critters.slot_mut_moving(a) {
             if c.alive && !c.is_wall() {
                 c.pos = if topo.wraps() {
@@ -390,7 +437,10 @@ fn run_with<V: Vector>(
             }
         }
     }
-    Ok(complete)
+    Ok(match grown {
+        Some(t) => Flight::Grown(t),
+        None => Flight::Done(complete),
+    })
 }
 
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
@@ -416,6 +466,8 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
         }
         sc.has_walls |= c.alive && c.is_wall();
     }
+    rmax = rmax.max(sc.least_rmax);
+    sc.rmax = rmax;
     sc.coord.clear();
     sc.coord.resize(n, [0; 3]);
     sc.body.clear();
