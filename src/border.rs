@@ -60,6 +60,10 @@ impl<V: Vector> Topology<V> {
         let mut d = b - a;
         if self.wraps() {
             let size = self.size();
+            // Most pairs are nearer than half the box on every axis: one test for all of them.
+            if d.within(size * 0.5) {
+                return d;
+            }
             for axis in 0..V::DIM {
                 let l = size.get(axis);
                 let x = d.get(axis);

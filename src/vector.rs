@@ -48,6 +48,8 @@ pub trait Vector:
     fn dot(self, other: Self) -> f64;
     /// True when every component is finite.
     fn all_finite(self) -> bool;
+    /// True when every component's magnitude is at most the same component of `bound`.
+    fn within(self, bound: Self) -> bool;
     /// The frame whose axes are the world axes.
     fn identity_frame() -> Self::Frame;
     /// Axis `axis` of `frame`, in world coordinates.
@@ -109,6 +111,10 @@ impl Vector for DVec2 {
         self.is_finite()
     }
     #[inline]
+    fn within(self, bound: Self) -> bool {
+        self.abs().cmple(bound).all()
+    }
+    #[inline]
     fn identity_frame() -> Self::Frame {
         DVec2::X
     }
@@ -162,6 +168,10 @@ impl Vector for DVec3 {
     #[inline]
     fn all_finite(self) -> bool {
         self.is_finite()
+    }
+    #[inline]
+    fn within(self, bound: Self) -> bool {
+        self.abs().cmple(bound).all()
     }
     #[inline]
     fn identity_frame() -> Self::Frame {

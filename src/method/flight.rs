@@ -27,7 +27,7 @@
 //! contacts under gravity); when it runs out the step is finished by the discrete pass and
 //! counted in `StepStats::budget_exceeded`.
 
-use crate::border::Border;
+use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
@@ -681,9 +681,8 @@ fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
         }
         let count = cells_around(w, sc, a, &mut around);
         for &k in &around[..count] {
-            for i in 0..sc.cells.members(k).len() {
-                let b = sc.cells.members(k)[i];
-                if b > a && shells_overlap(w, sc, a, b) {
+            for &b in sc.cells.members(k) {
+                if b > a && shells_overlap(&w.topo, &sc.body, &sc.center, sc.shell, a, b) {
                     sc.near.push(a as usize, b);
                     sc.near.push(b as usize, a);
                 }
@@ -693,16 +692,23 @@ fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
 }
 
 /// Whether the shells of `a` and `b` (a live disk) overlap: only such pairs can touch before
-/// one of them leaves its shell.
+/// one of them leaves its shell. Takes the flight's fields rather than the flight, so that the
+/// listing can push to `near` while it walks `cells`.
 #[inline]
-fn shells_overlap<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, b: u32) -> bool {
-    let rb = sc.body[b as usize].radius;
+fn shells_overlap<V: Vector>(
+    topo: &Topology<V>,
+    body: &[Body<V>],
+    center: &[V],
+    shell: f64,
+    a: u32,
+    b: u32,
+) -> bool {
+    let rb = body[b as usize].radius;
     if rb.is_nan() {
         return false;
     }
-    let reach = (sc.body[a as usize].radius + rb + sc.shell) * (1.0 + 1e-9);
-    w.topo
-        .delta(sc.center[a as usize], sc.center[b as usize])
+    let reach = (body[a as usize].radius + rb + shell) * (1.0 + 1e-9);
+    topo.delta(center[a as usize], center[b as usize])
         .length_squared()
         < reach * reach
 }
@@ -771,9 +777,8 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     let mut around = [0usize; 27];
     let count = cells_around(w, sc, a, &mut around);
     for &k in &around[..count] {
-        for i in 0..sc.cells.members(k).len() {
-            let b = sc.cells.members(k)[i];
-            if b != a && shells_overlap(w, sc, a, b) {
+        for &b in sc.cells.members(k) {
+            if b != a && shells_overlap(&w.topo, &sc.body, &sc.center, sc.shell, a, b) {
                 sc.near.push(ai, b);
                 if !sc.near.members(b as usize).contains(&a) {
                     sc.near.push(b as usize, a);
@@ -882,10 +887,14 @@ fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
 }
 
 /// Position, velocity and acceleration of body `a` at time `t` (its own clock is `body.t`).
-#[inline]
+#[inline(always)]
 fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
     let b = &sc.body[a as usize];
-    let acc = if sc.straight || !sc.meta[a as usize].free {
+    if sc.straight {
+        // A line: no zero acceleration to multiply and add (a pair test's most common call).
+        return (b.pos + b.vel * (t - b.t), b.vel, V::zero());
+    }
+    let acc = if !sc.meta[a as usize].free {
         V::zero()
     } else {
         sc.acc
@@ -984,9 +993,20 @@ fn predict_all<V: Vector>(
     let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
     if sc.shells {
-        for i in 0..sc.near.members(a as usize).len() {
-            let b = sc.near.members(a as usize)[i];
-            predict_disk(w, sc, a, b, t, mine)?;
+        // A copy of the list, so the loop does not find it again in `near` for every partner
+        // (predicting needs the flight mutably). Longer lists than this are rare.
+        let mut copy = [0u32; 64];
+        let n = sc.near.members(a as usize).len();
+        if n <= copy.len() {
+            copy[..n].copy_from_slice(sc.near.members(a as usize));
+            for &b in &copy[..n] {
+                predict_disk(w, sc, a, b, t, mine)?;
+            }
+        } else {
+            for i in 0..n {
+                let b = sc.near.members(a as usize)[i];
+                predict_disk(w, sc, a, b, t, mine)?;
+            }
         }
     } else if interior::<V>(sc, a) {
         // The common case: the neighbours are fixed offsets away, no wrapping, no repeats.
