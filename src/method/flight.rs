@@ -993,18 +993,15 @@ fn predict_all<V: Vector>(
     let mine = state_at(sc, a, t);
     let home = sc.cell[a as usize] as usize;
     if sc.shells {
-        // A copy of the list, so the loop does not find it again in `near` for every partner
-        // (predicting needs the flight mutably). Longer lists than this are rare.
-        let mut copy = [0u32; 64];
+        // The list copied out in runs, so the loop does not find it again in `near` for every
+        // partner (predicting needs the flight mutably).
+        const RUN: usize = 64;
+        let mut copy = [0u32; RUN];
         let n = sc.near.members(a as usize).len();
-        if n <= copy.len() {
-            copy[..n].copy_from_slice(sc.near.members(a as usize));
-            for &b in &copy[..n] {
-                predict_disk(w, sc, a, b, t, mine)?;
-            }
-        } else {
-            for i in 0..n {
-                let b = sc.near.members(a as usize)[i];
+        for start in (0..n).step_by(RUN) {
+            let run = &mut copy[..(n - start).min(RUN)];
+            run.copy_from_slice(&sc.near.members(a as usize)[start..start + run.len()]);
+            for &b in run.iter() {
                 predict_disk(w, sc, a, b, t, mine)?;
             }
         }
