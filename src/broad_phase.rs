@@ -5,8 +5,11 @@
 //! object's width), so widely varying radii cost no more than uniform ones: an object meets the
 //! objects of its own level in its own and the neighbouring cells (a half stencil, so each pair is
 //! produced once), and those of every coarser level in the 3^D cells around its position there.
-//! Within a level the objects are counting-sorted by cell, which keeps memory access local. The
-//! output order depends only on the objects, never on a hash or a thread count.
+//! Within a level the objects are counting-sorted by cell, which keeps memory access local; the
+//! sorted copies are single-precision boxes rounded outwards (`CellBox`), so the walk may find
+//! a pair that only touches through the rounding, and every pair it finds is tested again against
+//! the exact boxes. The output order depends only on the objects, never on a hash or a thread
+//! count.
 //!
 //! For small scenes a direct loop over all pairs is cheaper than building a grid; [`SMALL_N`] is
 //! where `benches/step.rs` measured the two to cross. Above it, [`BroadPhaseMode::Auto`] keeps a
@@ -48,29 +51,26 @@ pub enum BroadPhaseMode {
 }
 
 /// One level of the grid: its cells and its members, copied in cell order.
-struct Level<V> {
+struct Level<V: Vector> {
     inv_cell: [f64; 3],
     dims: [usize; 3],
     wrap: [bool; 3],
-    /// Object indices on this level.
-    members: Vec<u32>,
-    /// Cell key of each member (parallel to `members`).
+    /// Cell key of each member, in the order of their indices.
     keys: Vec<u32>,
     /// `start[k]..start[k + 1]` indexes `sorted` for cell `k`.
     start: Vec<u32>,
-    /// The members' objects in cell order, so the pair loops read memory in order.
-    sorted: Vec<BroadObject<V>>,
+    /// The members' boxes in cell order, so the pair loops read memory in order.
+    sorted: Vec<CellBox<V>>,
     /// Cell key of each entry of `sorted`.
     sorted_keys: Vec<u32>,
 }
 
-impl<V> Default for Level<V> {
+impl<V: Vector> Default for Level<V> {
     fn default() -> Self {
         Level {
             inv_cell: [0.0; 3],
             dims: [1; 3],
             wrap: [false; 3],
-            members: Vec::new(),
             keys: Vec::new(),
             start: Vec::new(),
             sorted: Vec::new(),
@@ -162,14 +162,15 @@ impl<V: Vector> Level<V> {
 
     /// Per axis, the first cell and the number of cells of this level whose members may overlap
     /// the box of `b` (members are at most one cell wide). Never more cells than the axis has.
-    fn footprint(&self, topo: &Topology<V>, b: &BroadObject<V>) -> [(i64, usize); 3] {
+    fn footprint(&self, topo: &Topology<V>, b: &CellBox<V>) -> [(i64, usize); 3] {
+        let (center, half) = (b.center(), b.half());
         let mut out = [(0i64, 1usize); 3];
         for (axis, slot) in out.iter_mut().enumerate().take(V::DIM) {
             let n = self.dims[axis];
             if n == 1 {
                 continue;
             }
-            let margin = b.half.get(axis) + 0.5 / self.inv_cell[axis];
+            let margin = half.get(axis) + 0.5 / self.inv_cell[axis];
             let origin = topo.min.get(axis);
             let cell_of = |x: f64| {
                 ((x - origin) * self.inv_cell[axis])
@@ -177,8 +178,8 @@ impl<V: Vector> Level<V> {
                     .clamp(-1e15, 1e15) as i64
             };
             let (first, last) = (
-                cell_of(b.center.get(axis) - margin),
-                cell_of(b.center.get(axis) + margin),
+                cell_of(center.get(axis) - margin),
+                cell_of(center.get(axis) + margin),
             );
             *slot = if self.wrap[axis] {
                 if last - first + 1 >= n as i64 {
@@ -216,7 +217,7 @@ impl<V: Vector> Level<V> {
     }
 
     #[inline]
-    fn cell(&self, key: usize) -> &[BroadObject<V>] {
+    fn cell(&self, key: usize) -> &[CellBox<V>] {
         &self.sorted[self.start[key] as usize..self.start[key + 1] as usize]
     }
 
@@ -262,8 +263,8 @@ impl<V: Vector> Level<V> {
             for (j, a) in here.iter().enumerate() {
                 for b in &here[j + 1..] {
                     tests += 1;
-                    if overlaps(topo, a, b) {
-                        out.push((a.slot, b.slot));
+                    if cells_overlap(topo, a, b) {
+                        out.push((a.index(), b.index()));
                     }
                 }
             }
@@ -281,8 +282,8 @@ impl<V: Vector> Level<V> {
                 for a in here {
                     for b in there {
                         tests += 1;
-                        if overlaps(topo, a, b) {
-                            out.push((a.slot, b.slot));
+                        if cells_overlap(topo, a, b) {
+                            out.push((a.index(), b.index()));
                         }
                     }
                 }
@@ -315,17 +316,16 @@ impl<V: Vector> Level<V> {
     }
 
     /// Sizes the level's grid for cells at least `cell` wide (and at most `limit` cells), sorts
-    /// its members by cell, and returns the cell width used.
-    /// The sorted copies are widened by `pad` and, with `by_index`, named by their index in
-    /// `objs` instead of their slot.
-    fn build(
+    /// its members (the indices in `objs` that `members` gives) by cell, and returns the cell
+    /// width used. The sorted copies are widened by `pad` and named by their index in `objs`.
+    fn build<M: Iterator<Item = u32>>(
         &mut self,
         objs: &[BroadObject<V>],
+        members: impl Fn() -> M,
         topo: &Topology<V>,
         mut cell: f64,
         limit: f64,
         pad: f64,
-        by_index: bool,
     ) -> f64 {
         let size = topo.size();
         loop {
@@ -364,7 +364,7 @@ impl<V: Vector> Level<V> {
         self.start.clear();
         self.start.resize(ncells + 1, 0);
         self.keys.clear();
-        for &i in &self.members {
+        for i in members() {
             let k = self.key(self.coords(topo, objs[i as usize].center));
             self.keys.push(k as u32);
             self.start[k] += 1;
@@ -376,29 +376,18 @@ impl<V: Vector> Level<V> {
             *s = acc;
             acc += count;
         }
-        let m = self.members.len();
-        let filler = BroadObject {
-            center: V::zero(),
-            half: V::zero(),
-            slot: 0,
-            is_wall: false,
-        };
+        let m = self.keys.len();
         self.sorted.clear();
-        self.sorted.resize(m, filler);
+        self.sorted.resize(m, CellBox::default());
         self.sorted_keys.clear();
         self.sorted_keys.resize(m, 0);
         // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
         // the shift below turns ends back into starts.
-        for (j, &i) in self.members.iter().enumerate() {
+        for (j, i) in members().enumerate() {
             let k = self.keys[j] as usize;
             let at = self.start[k] as usize;
             let o = &objs[i as usize];
-            self.sorted[at] = BroadObject {
-                center: o.center,
-                half: o.half + V::splat(pad),
-                slot: if by_index { i } else { o.slot },
-                is_wall: o.is_wall,
-            };
+            self.sorted[at] = CellBox::new(o, i, pad);
             self.sorted_keys[at] = k as u32;
             self.start[k] += 1;
         }
@@ -491,6 +480,12 @@ impl<V: Vector> Bound<V> {
     }
 }
 
+/// The smallest `f32` not below `x`, or one just above it (NaN for NaN).
+#[inline]
+fn at_least(x: f64) -> f32 {
+    -at_most(-x)
+}
+
 /// The largest `f32` not above `x`, or one just below it (NaN for NaN, so a bound made from it
 /// holds nothing).
 #[inline]
@@ -539,6 +534,8 @@ pub struct BroadPhase<V: Vector> {
     list: PairList<V>,
     levels: Vec<Level<V>>,
     level_of: Vec<u8>,
+    /// The grid's pairs before their exact test, kept between calls (`BroadPhaseMode::Grid`).
+    found: Vec<(u32, u32)>,
     /// Number of bounding-box tests made in the last call.
     pub tests: u64,
     /// Number of grid levels used in the last call (0 for the direct loop).
@@ -552,6 +549,7 @@ impl<V: Vector> Default for BroadPhase<V> {
             list: PairList::default(),
             levels: Vec::new(),
             level_of: Vec::new(),
+            found: Vec::new(),
             tests: 0,
             levels_used: 0,
         }
@@ -566,6 +564,84 @@ fn overlaps<V: Vector>(topo: &Topology<V>, a: &BroadObject<V>, b: &BroadObject<V
     let d = topo.delta(a.center, b.center);
     for axis in 0..V::DIM {
         if d.get(axis).abs() > a.half.get(axis) + b.half.get(axis) {
+            return false;
+        }
+    }
+    true
+}
+
+/// The pair of `objs` at indices `(i, j)` by slot, if their boxes overlap.
+#[inline(always)]
+fn exact<V: Vector>(
+    objs: &[BroadObject<V>],
+    topo: &Topology<V>,
+    &(i, j): &(u32, u32),
+) -> Option<(u32, u32)> {
+    let (a, b) = (&objs[i as usize], &objs[j as usize]);
+    overlaps(topo, a, b).then_some((a.slot, b.slot))
+}
+
+/// The tag bit of a wall's [`CellBox`].
+const WALL: u32 = 1 << 31;
+
+/// An object's box as a level's cell-sorted copy keeps it: the centre to the nearest `f32` and
+/// the half sizes (widened by the pad) rounded up past the centre's rounding, so the box holds the
+/// exact one; 20 bytes in 2D and 28 in 3D against 40 and 56 for a [`BroadObject`]. The grid's
+/// walk may therefore find a pair whose exact boxes only touch through the rounding, never miss
+/// one whose exact boxes overlap; the Verlet list and the grid mode test every pair it finds
+/// again against the exact boxes.
+#[derive(Clone, Copy, Debug, Default)]
+struct CellBox<V: Vector> {
+    center: V::Single,
+    half: V::Single,
+    /// The object's index in `objs`, with [`WALL`] set for a wall.
+    tag: u32,
+}
+
+impl<V: Vector> CellBox<V> {
+    #[inline]
+    fn new(o: &BroadObject<V>, index: u32, pad: f64) -> Self {
+        let (mut center, mut half) = (V::Single::default(), V::Single::default());
+        let (centers, halves): (&mut [f32], &mut [f32]) = (center.as_mut(), half.as_mut());
+        for axis in 0..V::DIM {
+            let c = o.center.get(axis);
+            centers[axis] = c as f32;
+            halves[axis] = at_least(o.half.get(axis) + pad + (f64::from(centers[axis]) - c).abs());
+        }
+        CellBox {
+            center,
+            half,
+            tag: if o.is_wall { index | WALL } else { index },
+        }
+    }
+
+    #[inline]
+    fn center(&self) -> V {
+        V::from_single(self.center)
+    }
+
+    #[inline]
+    fn half(&self) -> V {
+        V::from_single(self.half)
+    }
+
+    /// The object's index in `objs`.
+    #[inline]
+    fn index(&self) -> u32 {
+        self.tag & !WALL
+    }
+}
+
+/// [`overlaps`] for cells' boxes.
+#[inline(always)]
+fn cells_overlap<V: Vector>(topo: &Topology<V>, a: &CellBox<V>, b: &CellBox<V>) -> bool {
+    if a.tag & b.tag & WALL != 0 {
+        return false;
+    }
+    let d = topo.delta(a.center(), b.center());
+    let (ha, hb) = (a.half(), b.half());
+    for axis in 0..V::DIM {
+        if d.get(axis).abs() > ha.get(axis) + hb.get(axis) {
             return false;
         }
     }
@@ -619,10 +695,7 @@ impl<V: Vector> BroadPhase<V> {
         if !self.list_still_valid(objs, topo) {
             self.rebuild_list(objs, topo);
         }
-        let test = |&(i, j): &(u32, u32)| {
-            let (a, b) = (&objs[i as usize], &objs[j as usize]);
-            overlaps(topo, a, b).then_some((a.slot, b.slot))
-        };
+        let test = |pair: &(u32, u32)| exact(objs, topo, pair);
         self.tests += self.list.pairs.len() as u64;
         if objs.len() >= crate::world::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread count.
@@ -662,7 +735,7 @@ impl<V: Vector> BroadPhase<V> {
         // Boxes widened by half the skin, pairs named by index so they index `objs`.
         let mut pairs = std::mem::take(&mut self.list.pairs);
         pairs.clear();
-        self.grid_padded(objs, topo, &mut pairs, 0.5 * skin, true);
+        self.grid_padded(objs, topo, &mut pairs, 0.5 * skin);
         self.list.pairs = pairs;
         let bound = |o: &BroadObject<V>| Bound::new(o, 0.5 * skin);
         self.list.bounds.clear();
@@ -699,20 +772,31 @@ impl<V: Vector> BroadPhase<V> {
         }
     }
 
+    /// The grid rebuilt for this call: its cells' single-precision boxes may find a few more
+    /// pairs than overlap, so each is tested again against the exact boxes.
     fn grid(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
-        self.grid_padded(objs, topo, out, 0.0, false);
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
+        self.grid_padded(objs, topo, &mut found, 0.0);
+        self.tests += found.len() as u64;
+        out.extend(found.iter().filter_map(|pair| exact(objs, topo, pair)));
+        self.found = found;
     }
 
-    /// The grid's pairs of the boxes widened by `pad`, named by slot, or with `by_index` by
-    /// their index in `objs`.
+    /// The pairs of the grid's cells' boxes (`objs` widened by `pad`, in single precision rounded
+    /// outwards: every pair whose widened boxes overlap, and perhaps a few whose boxes only
+    /// touch through the rounding), named by their indices in `objs`.
     fn grid_padded(
         &mut self,
         objs: &[BroadObject<V>],
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
         pad: f64,
-        by_index: bool,
     ) {
+        assert!(
+            objs.len() < WALL as usize,
+            "the broad phase names objects by 31-bit indices"
+        );
         // Widths, finest width, and each object's level.
         let width = |o: &BroadObject<V>| {
             let mut w: f64 = 0.0;
@@ -744,11 +828,9 @@ impl<V: Vector> BroadPhase<V> {
         if self.levels.len() < top + 1 {
             self.levels.resize_with(top + 1, Level::default);
         }
-        for level in &mut self.levels {
-            level.members.clear();
-        }
-        for (i, &l) in self.level_of.iter().enumerate() {
-            self.levels[l as usize].members.push(i as u32);
+        let mut occupied = [false; 64];
+        for &l in &self.level_of {
+            occupied[l as usize] = true;
         }
 
         // Build each non-empty level's grid, finest first, cells never narrower than the level
@@ -757,13 +839,25 @@ impl<V: Vector> BroadPhase<V> {
         let limit = (4 * objs.len()).max(64) as f64;
         let mut floor_cell = 0.0f64;
         let mut used = Vec::new();
-        for l in 0..=top {
-            if self.levels[l].members.is_empty() {
-                continue;
-            }
+        for (l, _) in occupied
+            .iter()
+            .enumerate()
+            .take(top + 1)
+            .filter(|(_, &o)| o)
+        {
             used.push(l);
             let cell = (s0 * (l as f64).exp2()).max(floor_cell);
-            floor_cell = self.levels[l].build(objs, topo, cell, limit, pad, by_index);
+            // A level's members are found by a pass over one byte per object rather than kept
+            // in a list of their own (4 bytes per object less at the peak).
+            let level_of = &self.level_of;
+            let members = || {
+                level_of
+                    .iter()
+                    .enumerate()
+                    .filter(move |&(_, &at)| usize::from(at) == l)
+                    .map(|(i, _)| i as u32)
+            };
+            floor_cell = self.levels[l].build(objs, members, topo, cell, limit, pad);
         }
         self.levels_used = used.len();
 
@@ -831,8 +925,8 @@ impl<V: Vector> BroadPhase<V> {
                                     ];
                                     for a in fine_level.cell(fine_level.key(c)) {
                                         self.tests += 1;
-                                        if overlaps(topo, a, b) {
-                                            out.push((a.slot, b.slot));
+                                        if cells_overlap(topo, a, b) {
+                                            out.push((a.index(), b.index()));
                                         }
                                     }
                                 }
@@ -842,15 +936,17 @@ impl<V: Vector> BroadPhase<V> {
                 } else {
                     let all = coarse_level.offsets(false);
                     for a in &fine_level.sorted {
-                        let c = coarse_level.coords(topo, a.center);
+                        // The cell of the exact centre, as the coarse level's members were
+                        // sorted by theirs (the rounded one could fall one cell over).
+                        let c = coarse_level.coords(topo, objs[a.index() as usize].center);
                         for &o in &all {
                             let Some(nk) = coarse_level.neighbour(c, o) else {
                                 continue;
                             };
                             for b in coarse_level.cell(nk) {
                                 self.tests += 1;
-                                if overlaps(topo, a, b) {
-                                    out.push((a.slot, b.slot));
+                                if cells_overlap(topo, a, b) {
+                                    out.push((a.index(), b.index()));
                                 }
                             }
                         }
@@ -931,6 +1027,69 @@ mod tests {
         }
         assert!(at_most(f64::NAN).is_nan());
         assert_eq!(at_most(f64::INFINITY), f32::INFINITY);
+    }
+
+    #[test]
+    fn a_cell_box_holds_its_widened_box_and_finds_every_pair_the_exact_boxes_find() {
+        let mut rng = Rng::new(11);
+        let topo = Topology {
+            min: DVec3::splat(-3e4),
+            max: DVec3::splat(3e4),
+            border: Border::Wrap,
+        };
+        let mut found = 0;
+        for i in 0..100_000u32 {
+            let scale = 10f64.powf(rng.uniform(-3.0, 1.0));
+            let pad = scale * rng.uniform(0.0, 0.3);
+            let object = |rng: &mut Rng, center: DVec3| BroadObject {
+                center,
+                half: DVec3::new(
+                    scale * rng.uniform(0.1, 1.0),
+                    scale * rng.uniform(0.1, 1.0),
+                    scale * rng.uniform(0.1, 1.0),
+                ),
+                slot: 0,
+                is_wall: false,
+            };
+            let at = DVec3::new(
+                rng.uniform(-3e4, 3e4),
+                rng.uniform(-3e4, 3e4),
+                rng.uniform(-3e4, 3e4),
+            );
+            let a = object(&mut rng, at);
+            let cell = CellBox::<DVec3>::new(&a, i, pad);
+            for axis in 0..3 {
+                let (c, h) = (cell.center.as_ref()[axis], cell.half.as_ref()[axis]);
+                let reach = (f64::from(c) - a.center.get(axis)).abs() + a.half.get(axis) + pad;
+                assert!(reach <= f64::from(h), "axis {axis}: {a:?} widened by {pad}");
+            }
+            assert_eq!(cell.index(), i);
+            // A second box placed so the widened boxes just overlap or just miss, across the
+            // periodic seam for some: the cells' boxes overlap whenever the widened ones do.
+            let mut b = object(&mut rng, DVec3::ZERO);
+            let reach = a.half + b.half + DVec3::splat(2.0 * pad);
+            let offset = reach
+                * DVec3::new(
+                    rng.uniform(-1.0, 1.0),
+                    rng.uniform(-1.0, 1.0),
+                    rng.uniform(-1.0, 1.0),
+                )
+                .signum()
+                * (1.0 - 1e-12 * rng.uniform(-1.0, 1.0));
+            b.center = topo.wrap_position(a.center + offset);
+            let widen = |o: &BroadObject<DVec3>| BroadObject {
+                half: o.half + DVec3::splat(pad),
+                ..*o
+            };
+            if overlaps(&topo, &widen(&a), &widen(&b)) {
+                found += 1;
+                assert!(
+                    cells_overlap(&topo, &cell, &CellBox::new(&b, 0, pad)),
+                    "{a:?} and {b:?} widened by {pad}"
+                );
+            }
+        }
+        assert!(found > 10_000, "only {found} pairs just overlapped");
     }
 
     #[test]
@@ -1168,8 +1327,13 @@ mod tests {
         let mut whole = Vec::new();
         let tests = level.pairs_within(&topo, &forward, &deltas, 0..objs.len(), &mut whole);
         assert!(whole.len() > 1000, "{} pairs", whole.len());
-        assert_eq!(out, whole);
-        assert_eq!(bp.tests, tests);
+        assert_eq!(bp.found, whole);
+        assert_eq!(bp.tests, tests + whole.len() as u64);
+        let exact_pairs: Vec<(u32, u32)> = whole
+            .iter()
+            .filter_map(|pair| exact(&objs, &topo, pair))
+            .collect();
+        assert_eq!(out, exact_pairs);
         assert_eq!(found(1).1, out);
     }
 

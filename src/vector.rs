@@ -33,7 +33,7 @@ pub trait Vector:
     /// one of its fields): 64 bytes in 2D, so a critter's hot fields share one cache line.
     type CritterAlign: Clone + Copy + Debug + Send + Sync;
     /// The same number of components in single precision, for compact copies (the broad phase's
-    /// bounds of the Verlet list).
+    /// cell-sorted boxes and the bounds of its Verlet list).
     type Single: Clone + Copy + Debug + Default + Send + Sync + AsRef<[f32]> + AsMut<[f32]>;
 
     /// The zero vector.
@@ -50,6 +50,8 @@ pub trait Vector:
     fn all_finite(self) -> bool;
     /// True when every component's magnitude is at most the same component of `bound`.
     fn within(self, bound: Self) -> bool;
+    /// The vector with the components of `s` (exactly: every `f32` is an `f64`).
+    fn from_single(s: Self::Single) -> Self;
     /// The frame whose axes are the world axes.
     fn identity_frame() -> Self::Frame;
     /// Axis `axis` of `frame`, in world coordinates.
@@ -115,6 +117,10 @@ impl Vector for DVec2 {
         self.abs().cmple(bound).all()
     }
     #[inline]
+    fn from_single(s: [f32; 2]) -> Self {
+        DVec2::new(f64::from(s[0]), f64::from(s[1]))
+    }
+    #[inline]
     fn identity_frame() -> Self::Frame {
         DVec2::X
     }
@@ -172,6 +178,10 @@ impl Vector for DVec3 {
     #[inline]
     fn within(self, bound: Self) -> bool {
         self.abs().cmple(bound).all()
+    }
+    #[inline]
+    fn from_single(s: [f32; 3]) -> Self {
+        DVec3::new(f64::from(s[0]), f64::from(s[1]), f64::from(s[2]))
     }
     #[inline]
     fn identity_frame() -> Self::Frame {
