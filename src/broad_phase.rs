@@ -450,12 +450,10 @@ struct Bound<V: Vector> {
 impl<V: Vector> Bound<V> {
     #[inline]
     fn new(o: &BroadObject<V>, pad: f64) -> Self {
-        let (mut center, mut room) = (V::Single::default(), V::Single::default());
-        let (centers, rooms): (&mut [f32], &mut [f32]) = (center.as_mut(), room.as_mut());
-        for axis in 0..V::DIM {
-            let c = o.center.get(axis);
-            centers[axis] = c as f32;
-            rooms[axis] = at_most(o.half.get(axis) + pad - (f64::from(centers[axis]) - c).abs());
+        let (center, moved) = rounded(o.center);
+        let mut room = V::Single::default();
+        for (axis, r) in room.as_mut().iter_mut().enumerate() {
+            *r = at_most(o.half.get(axis) + pad - moved.get(axis));
         }
         Bound {
             center,
@@ -470,14 +468,22 @@ impl<V: Vector> Bound<V> {
         if o.slot != self.slot {
             return false;
         }
-        let mut center = V::zero();
-        for (axis, &c) in self.center.as_ref().iter().enumerate() {
-            center.set(axis, f64::from(c));
-        }
-        let d = topo.delta(center, o.center);
+        let d = topo.delta(V::from_single(self.center), o.center);
         let room = self.room.as_ref();
         (0..V::DIM).all(|axis| d.get(axis).abs() + o.half.get(axis) <= f64::from(room[axis]))
     }
+}
+
+/// `v` to the nearest `f32` on each axis, and how far each component moved (its magnitude).
+#[inline]
+fn rounded<V: Vector>(v: V) -> (V::Single, V) {
+    let mut single = V::Single::default();
+    let mut moved = V::zero();
+    for (axis, x) in single.as_mut().iter_mut().enumerate() {
+        *x = v.get(axis) as f32;
+        moved.set(axis, (f64::from(*x) - v.get(axis)).abs());
+    }
+    (single, moved)
 }
 
 /// The smallest `f32` not below `x`, or one just above it (NaN for NaN).
@@ -601,12 +607,10 @@ struct CellBox<V: Vector> {
 impl<V: Vector> CellBox<V> {
     #[inline]
     fn new(o: &BroadObject<V>, index: u32, pad: f64) -> Self {
-        let (mut center, mut half) = (V::Single::default(), V::Single::default());
-        let (centers, halves): (&mut [f32], &mut [f32]) = (center.as_mut(), half.as_mut());
-        for axis in 0..V::DIM {
-            let c = o.center.get(axis);
-            centers[axis] = c as f32;
-            halves[axis] = at_least(o.half.get(axis) + pad + (f64::from(centers[axis]) - c).abs());
+        let (center, moved) = rounded(o.center);
+        let mut half = V::Single::default();
+        for (axis, h) in half.as_mut().iter_mut().enumerate() {
+            *h = at_least(o.half.get(axis) + pad + moved.get(axis));
         }
         CellBox {
             center,
@@ -839,12 +843,7 @@ impl<V: Vector> BroadPhase<V> {
         let limit = (4 * objs.len()).max(64) as f64;
         let mut floor_cell = 0.0f64;
         let mut used = Vec::new();
-        for (l, _) in occupied
-            .iter()
-            .enumerate()
-            .take(top + 1)
-            .filter(|(_, &o)| o)
-        {
+        for l in (0..=top).filter(|&l| occupied[l]) {
             used.push(l);
             let cell = (s0 * (l as f64).exp2()).max(floor_cell);
             // A level's members are found by a pass over one byte per object rather than kept
