@@ -37,6 +37,32 @@ pub struct BroadObject<V> {
     pub is_wall: bool,
 }
 
+/// Where the broad phase reads its objects: indices `0..slots()`, each an object or a gap (a
+/// slot with no live critter). Pairs are reported by the objects' `slot`s. A slice of objects is
+/// one; the world reads its critters' slots in place, so no list of objects is kept per step.
+pub trait Objects<V: Vector>: Sync {
+    /// How many indices there are.
+    fn slots(&self) -> usize;
+    /// The object at index `i < slots()`, or `None` for a gap.
+    fn object(&self, i: usize) -> Option<BroadObject<V>>;
+    /// A hint that `object(i)` will be asked for soon: a source that reads scattered memory
+    /// may start loading it.
+    #[inline]
+    fn prefetch(&self, _i: usize) {}
+}
+
+impl<V: Vector> Objects<V> for [BroadObject<V>] {
+    #[inline]
+    fn slots(&self) -> usize {
+        self.len()
+    }
+
+    #[inline]
+    fn object(&self, i: usize) -> Option<BroadObject<V>> {
+        self.get(i).copied()
+    }
+}
+
 /// Which algorithm to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BroadPhaseMode {
@@ -316,11 +342,10 @@ impl<V: Vector> Level<V> {
     }
 
     /// Sizes the level's grid for cells at least `cell` wide (and at most `limit` cells), sorts
-    /// its members (the indices in `objs` that `members` gives) by cell, and returns the cell
-    /// width used. The sorted copies are widened by `pad` and named by their index in `objs`.
-    fn build<M: Iterator<Item = u32>>(
+    /// its members (the objects `members` gives, with their indices) by cell, and returns the cell
+    /// width used. The sorted copies are widened by `pad` and named by their index.
+    fn build<M: Iterator<Item = (u32, BroadObject<V>)>>(
         &mut self,
-        objs: &[BroadObject<V>],
         members: impl Fn() -> M,
         topo: &Topology<V>,
         mut cell: f64,
@@ -364,8 +389,8 @@ impl<V: Vector> Level<V> {
         self.start.clear();
         self.start.resize(ncells + 1, 0);
         self.keys.clear();
-        for i in members() {
-            let k = self.key(self.coords(topo, objs[i as usize].center));
+        for (_, o) in members() {
+            let k = self.key(self.coords(topo, o.center));
             self.keys.push(k as u32);
             self.start[k] += 1;
         }
@@ -383,11 +408,10 @@ impl<V: Vector> Level<V> {
         self.sorted_keys.resize(m, 0);
         // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
         // the shift below turns ends back into starts.
-        for (j, i) in members().enumerate() {
+        for (j, (i, o)) in members().enumerate() {
             let k = self.keys[j] as usize;
             let at = self.start[k] as usize;
-            let o = &objs[i as usize];
-            self.sorted[at] = CellBox::new(o, i, pad);
+            self.sorted[at] = CellBox::new(&o, i, pad);
             self.sorted_keys[at] = k as u32;
             self.start[k] += 1;
         }
@@ -408,48 +432,66 @@ const SKIN: f64 = 0.4;
 /// Most objects sampled for the typical width.
 const WIDTH_SAMPLES: usize = 1024;
 
-/// The median width of the disks among up to [`WIDTH_SAMPLES`] objects spread evenly over `objs`
+/// The median width of the disks among up to [`WIDTH_SAMPLES`] indices spread evenly over `objs`
 /// (all of them when there are fewer); the smallest width of all when none of those is a disk;
 /// infinite for no objects. The skin follows it rather than the smallest width: with radii
 /// spread over a factor of 100, a skin of the smallest width is outrun by the small disks every
 /// step, and the list was rebuilt every step (12x the uniform gas's step). A median of a fixed
 /// sample costs nothing at any N and depends only on `objs`.
-fn typical_width<V: Vector>(
-    objs: &[BroadObject<V>],
+fn typical_width<V: Vector, O: Objects<V> + ?Sized>(
+    objs: &O,
     width: impl Fn(&BroadObject<V>) -> f64,
 ) -> f64 {
-    let n = objs.len();
+    let n = objs.slots();
     let step = n.div_ceil(WIDTH_SAMPLES).max(1);
     let mut sample = [0.0f64; WIDTH_SAMPLES];
     let mut taken = 0;
-    for o in objs.iter().step_by(step).filter(|o| !o.is_wall) {
-        sample[taken] = width(o);
-        taken += 1;
+    for o in (0..n).step_by(step).filter_map(|i| objs.object(i)) {
+        if !o.is_wall {
+            sample[taken] = width(&o);
+            taken += 1;
+        }
     }
     if taken == 0 {
-        return objs.iter().map(width).fold(f64::INFINITY, f64::min);
+        return (0..n)
+            .filter_map(|i| objs.object(i))
+            .map(|o| width(&o))
+            .fold(f64::INFINITY, f64::min);
     }
     let (_, median, _) = sample[..taken].select_nth_unstable_by(taken / 2, f64::total_cmp);
     *median
 }
 
-/// Where one object's box may be while the Verlet list stays valid: its box at the build widened
+/// Where one index's object may be while the Verlet list stays valid: its box at the build widened
 /// by half the skin, in single precision rounded inwards, so that a box inside the bound is inside
 /// the widened box its pairs were found with. Half the size of a [`BroadObject`] (20 bytes in 2D,
 /// 28 in 3D): at a million critters the bounds are 20 MB less to keep and to read every step.
 #[derive(Clone, Copy, Debug)]
 struct Bound<V: Vector> {
-    /// The centre at the build, to the nearest `f32`.
+    /// The centre at the build, to the nearest `f32` (NaN for a gap).
     center: V::Single,
     /// Per axis, how far the box may reach from `center`: the widened half size less the
     /// centre's rounding, rounded down.
     room: V::Single,
-    slot: u32,
+    /// The object's slot, with [`WALL`] set for a wall; [`GAP`] for a gap.
+    tag: u32,
 }
+
+/// The tag of a gap's [`Bound`] (its centre is NaN too, so no object is ever inside it).
+const GAP: u32 = u32::MAX;
 
 impl<V: Vector> Bound<V> {
     #[inline]
-    fn new(o: &BroadObject<V>, pad: f64) -> Self {
+    fn new(o: Option<&BroadObject<V>>, pad: f64) -> Self {
+        let Some(o) = o else {
+            let mut nan = V::Single::default();
+            nan.as_mut().fill(f32::NAN);
+            return Bound {
+                center: nan,
+                room: nan,
+                tag: GAP,
+            };
+        };
         let (center, moved) = rounded(o.center);
         let mut room = V::Single::default();
         for (axis, r) in room.as_mut().iter_mut().enumerate() {
@@ -458,19 +500,33 @@ impl<V: Vector> Bound<V> {
         Bound {
             center,
             room,
-            slot: o.slot,
+            tag: tag_of(o),
         }
     }
 
-    /// True when the box of `o` (the same slot) lies inside the bound. Never for a NaN.
+    /// True when `o` is what the bound was made from, a gap for a gap, or for an object the box
+    /// of one with the same slot and wall flag that lies inside the bound. Never for a NaN.
     #[inline]
-    fn holds(&self, topo: &Topology<V>, o: &BroadObject<V>) -> bool {
-        if o.slot != self.slot {
+    fn holds(&self, topo: &Topology<V>, o: Option<&BroadObject<V>>) -> bool {
+        let Some(o) = o else {
+            return self.tag == GAP;
+        };
+        if tag_of(o) != self.tag {
             return false;
         }
         let d = topo.delta(V::from_single(self.center), o.center);
         let room = self.room.as_ref();
         (0..V::DIM).all(|axis| d.get(axis).abs() + o.half.get(axis) <= f64::from(room[axis]))
+    }
+}
+
+/// An object's slot with [`WALL`] set for a wall.
+#[inline]
+fn tag_of<V: Vector>(o: &BroadObject<V>) -> u32 {
+    if o.is_wall {
+        o.slot | WALL
+    } else {
+        o.slot
     }
 }
 
@@ -576,19 +632,47 @@ fn overlaps<V: Vector>(topo: &Topology<V>, a: &BroadObject<V>, b: &BroadObject<V
     true
 }
 
-/// The pair of `objs` at indices `(i, j)` by slot, if their boxes overlap.
+/// The pair of `objs` at indices `(i, j)` by slot, if both are objects and their boxes overlap.
 #[inline(always)]
-fn exact<V: Vector>(
-    objs: &[BroadObject<V>],
+fn exact<V: Vector, O: Objects<V> + ?Sized>(
+    objs: &O,
     topo: &Topology<V>,
     &(i, j): &(u32, u32),
 ) -> Option<(u32, u32)> {
-    let (a, b) = (&objs[i as usize], &objs[j as usize]);
-    overlaps(topo, a, b).then_some((a.slot, b.slot))
+    let (a, b) = (objs.object(i as usize)?, objs.object(j as usize)?);
+    overlaps(topo, &a, &b).then_some((a.slot, b.slot))
 }
 
-/// The tag bit of a wall's [`CellBox`].
+/// How many indices ahead a level's passes over its members ask for objects to be prefetched.
+const MEMBERS_AHEAD: usize = 4;
+
+/// How many pairs ahead [`retest`] asks for its objects to be prefetched.
+const PAIRS_AHEAD: usize = 8;
+
+/// The pairs of `pairs` (indices) whose exact boxes overlap, by slot, pushed onto `out`. The
+/// objects of the pair [`PAIRS_AHEAD`] places on are asked for while this one is tested: the
+/// world reads them from its critters, scattered over memory, and the loads overlap.
+#[inline]
+fn retest<V: Vector, O: Objects<V> + ?Sized>(
+    objs: &O,
+    topo: &Topology<V>,
+    pairs: &[(u32, u32)],
+    out: &mut Vec<(u32, u32)>,
+) {
+    for (k, pair) in pairs.iter().enumerate() {
+        if let Some(&(i, j)) = pairs.get(k + PAIRS_AHEAD) {
+            objs.prefetch(i as usize);
+            objs.prefetch(j as usize);
+        }
+        out.extend(exact(objs, topo, pair));
+    }
+}
+
+/// The tag bit of a wall's [`CellBox`] and [`Bound`].
 const WALL: u32 = 1 << 31;
+
+/// The level of a gap (no level has it: levels go up to 63).
+const NO_LEVEL: u8 = u8::MAX;
 
 /// An object's box as a level's cell-sorted copy keeps it: the centre to the nearest `f32` and
 /// the half sizes (widened by the pad) rounded up past the centre's rounding, so the box holds the
@@ -669,70 +753,103 @@ impl<V: Vector> BroadPhase<V> {
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
     ) {
+        self.find_pairs_in(objs, topo, out, None);
+    }
+
+    /// [`Self::find_pairs`] for any [`Objects`]. `held` is what the caller already knows of the
+    /// Verlet list: `Some(true)` when [`Self::list_holds`] said yes for every index of `objs`,
+    /// `Some(false)` when it said no for one, `None` when it was not asked (the check is then
+    /// made here).
+    pub(crate) fn find_pairs_in<O: Objects<V> + ?Sized>(
+        &mut self,
+        objs: &O,
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+        held: Option<bool>,
+    ) {
         out.clear();
         self.tests = 0;
+        let n = objs.slots();
         let direct = match self.mode {
             BroadPhaseMode::AllPairs => true,
             BroadPhaseMode::Grid => false,
-            BroadPhaseMode::Auto => objs.len() <= SMALL_N,
+            BroadPhaseMode::Auto => n <= SMALL_N,
         };
-        if direct || objs.is_empty() {
+        if direct || n == 0 {
             self.levels_used = 0;
             self.all_pairs(objs, topo, out);
         } else if self.mode == BroadPhaseMode::Grid {
             self.grid(objs, topo, out);
         } else {
-            self.listed_pairs(objs, topo, out);
+            self.listed_pairs(objs, topo, out, held);
         }
+    }
+
+    /// True when the kept Verlet list still covers index `i` holding `o`: for a caller that
+    /// checks each object while it has it at hand (the world, in its move) and passes the
+    /// verdict to [`Self::find_pairs_in`]. False when there is no list.
+    #[inline]
+    pub(crate) fn list_holds(
+        &self,
+        topo: &Topology<V>,
+        i: usize,
+        o: Option<&BroadObject<V>>,
+    ) -> bool {
+        self.list.valid && self.list.bounds.get(i).is_some_and(|b| b.holds(topo, o))
     }
 
     /// Auto mode's pairs for large scenes: a Verlet list. The grid is built with every box
     /// widened by half a skin, and the pairs it finds are kept; while no object has moved more
     /// than half the skin from where it was then (and none came, went or changed size), every
     /// overlapping pair is among them, so a step only re-tests the kept pairs.
-    fn listed_pairs(
+    fn listed_pairs<O: Objects<V> + ?Sized>(
         &mut self,
-        objs: &[BroadObject<V>],
+        objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
+        held: Option<bool>,
     ) {
-        if !self.list_still_valid(objs, topo) {
+        let valid = self.list.valid
+            && self.list.bounds.len() == objs.slots()
+            && held.unwrap_or_else(|| self.list_still_valid(objs, topo));
+        if !valid {
             self.rebuild_list(objs, topo);
         }
-        let test = |pair: &(u32, u32)| exact(objs, topo, pair);
         self.tests += self.list.pairs.len() as u64;
-        if objs.len() >= crate::world::PARALLEL_MIN {
+        if objs.slots() >= crate::world::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread count.
             use rayon::prelude::*;
             let parts: Vec<Vec<(u32, u32)>> = self
                 .list
                 .pairs
                 .par_chunks(4096)
-                .map(|chunk| chunk.iter().filter_map(test).collect())
+                .map(|chunk| {
+                    let mut part = Vec::new();
+                    retest(objs, topo, chunk, &mut part);
+                    part
+                })
                 .collect();
             for part in parts {
                 out.extend(part);
             }
         } else {
-            out.extend(self.list.pairs.iter().filter_map(test));
+            retest(objs, topo, &self.list.pairs, out);
         }
     }
 
-    fn list_still_valid(&self, objs: &[BroadObject<V>], topo: &Topology<V>) -> bool {
-        let list = &self.list;
-        if !list.valid || list.bounds.len() != objs.len() {
-            return false;
-        }
-        let inside = |(o, b): (&BroadObject<V>, &Bound<V>)| b.holds(topo, o);
-        if objs.len() >= crate::world::PARALLEL_MIN {
+    /// Every index's object inside its bound (the list's length already checked).
+    fn list_still_valid<O: Objects<V> + ?Sized>(&self, objs: &O, topo: &Topology<V>) -> bool {
+        let bounds = &self.list.bounds;
+        let inside = |(i, b): (usize, &Bound<V>)| b.holds(topo, objs.object(i).as_ref());
+        if objs.slots() >= crate::world::PARALLEL_MIN {
             use rayon::prelude::*;
-            objs.par_iter().zip(&list.bounds).all(inside)
+            bounds.par_iter().enumerate().all(inside)
         } else {
-            objs.iter().zip(&list.bounds).all(inside)
+            bounds.iter().enumerate().all(inside)
         }
     }
 
-    fn rebuild_list(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>) {
+    fn rebuild_list<O: Objects<V> + ?Sized>(&mut self, objs: &O, topo: &Topology<V>) {
         let width =
             |o: &BroadObject<V>| (0..V::DIM).map(|a| 2.0 * o.half.get(a)).fold(0.0, f64::max);
         let skin = SKIN * typical_width(objs, width);
@@ -741,13 +858,15 @@ impl<V: Vector> BroadPhase<V> {
         pairs.clear();
         self.grid_padded(objs, topo, &mut pairs, 0.5 * skin);
         self.list.pairs = pairs;
-        let bound = |o: &BroadObject<V>| Bound::new(o, 0.5 * skin);
+        let bound = |i: usize| Bound::new(objs.object(i).as_ref(), 0.5 * skin);
         self.list.bounds.clear();
-        if objs.len() >= crate::world::PARALLEL_MIN {
+        if objs.slots() >= crate::world::PARALLEL_MIN {
             use rayon::prelude::*;
-            self.list.bounds.par_extend(objs.par_iter().map(bound));
+            self.list
+                .bounds
+                .par_extend((0..objs.slots()).into_par_iter().map(bound));
         } else {
-            self.list.bounds.extend(objs.iter().map(bound));
+            self.list.bounds.extend((0..objs.slots()).map(bound));
         }
         self.list.skin = skin;
         self.list.valid = true;
@@ -760,16 +879,17 @@ impl<V: Vector> BroadPhase<V> {
         self.list.rebuilds
     }
 
-    fn all_pairs(
+    fn all_pairs<O: Objects<V> + ?Sized>(
         &mut self,
-        objs: &[BroadObject<V>],
+        objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
     ) {
-        for (i, a) in objs.iter().enumerate() {
-            for b in &objs[i + 1..] {
+        let n = objs.slots();
+        for (i, a) in (0..n).filter_map(|i| Some((i, objs.object(i)?))) {
+            for b in (i + 1..n).filter_map(|j| objs.object(j)) {
                 self.tests += 1;
-                if overlaps(topo, a, b) {
+                if overlaps(topo, &a, &b) {
                     out.push((a.slot, b.slot));
                 }
             }
@@ -778,7 +898,12 @@ impl<V: Vector> BroadPhase<V> {
 
     /// The grid rebuilt for this call: its cells' single-precision boxes may find a few more
     /// pairs than overlap, so each is tested again against the exact boxes.
-    fn grid(&mut self, objs: &[BroadObject<V>], topo: &Topology<V>, out: &mut Vec<(u32, u32)>) {
+    fn grid<O: Objects<V> + ?Sized>(
+        &mut self,
+        objs: &O,
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
         let mut found = std::mem::take(&mut self.found);
         found.clear();
         self.grid_padded(objs, topo, &mut found, 0.0);
@@ -790,15 +915,16 @@ impl<V: Vector> BroadPhase<V> {
     /// The pairs of the grid's cells' boxes (`objs` widened by `pad`, in single precision rounded
     /// outwards: every pair whose widened boxes overlap, and perhaps a few whose boxes only
     /// touch through the rounding), named by their indices in `objs`.
-    fn grid_padded(
+    fn grid_padded<O: Objects<V> + ?Sized>(
         &mut self,
-        objs: &[BroadObject<V>],
+        objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
         pad: f64,
     ) {
+        let n = objs.slots();
         assert!(
-            objs.len() < WALL as usize,
+            n < WALL as usize,
             "the broad phase names objects by 31-bit indices"
         );
         // Widths, finest width, and each object's level.
@@ -809,15 +935,26 @@ impl<V: Vector> BroadPhase<V> {
             }
             w
         };
-        let s0 = objs
-            .iter()
-            .map(width)
-            .fold(f64::INFINITY, f64::min)
-            .max(f64::MIN_POSITIVE);
-        self.level_of.clear();
-        let mut top = 0usize;
-        for o in objs {
-            let w = width(o);
+        // Two passes over the objects (at 1e6 the world's are critters 128 bytes apart), on
+        // rayon's threads for a large scene: a minimum and an indexed map give the same result
+        // for any thread count.
+        let parallel = n >= crate::world::PARALLEL_MIN;
+        let smallest = |i: usize| objs.object(i).map_or(f64::INFINITY, |o| width(&o));
+        let s0 = if parallel {
+            use rayon::prelude::*;
+            (0..n)
+                .into_par_iter()
+                .map(smallest)
+                .reduce(|| f64::INFINITY, f64::min)
+        } else {
+            (0..n).map(smallest).fold(f64::INFINITY, f64::min)
+        }
+        .max(f64::MIN_POSITIVE);
+        let level = |i: usize| {
+            let Some(o) = objs.object(i) else {
+                return NO_LEVEL;
+            };
+            let w = width(&o);
             let mut level = 0usize;
             if w > s0 {
                 level = (w / s0).log2().ceil().max(0.0) as usize;
@@ -826,21 +963,32 @@ impl<V: Vector> BroadPhase<V> {
                 }
                 level = level.min(63);
             }
-            top = top.max(level);
-            self.level_of.push(level as u8);
+            level as u8
+        };
+        self.level_of.clear();
+        if parallel {
+            use rayon::prelude::*;
+            self.level_of.par_extend((0..n).into_par_iter().map(level));
+        } else {
+            self.level_of.extend((0..n).map(level));
+        }
+        let (mut top, mut count) = (0usize, 0usize);
+        for &l in self.level_of.iter().filter(|&&l| l != NO_LEVEL) {
+            top = top.max(usize::from(l));
+            count += 1;
         }
         if self.levels.len() < top + 1 {
             self.levels.resize_with(top + 1, Level::default);
         }
         let mut occupied = [false; 64];
-        for &l in &self.level_of {
+        for &l in self.level_of.iter().filter(|&&l| l != NO_LEVEL) {
             occupied[l as usize] = true;
         }
 
         // Build each non-empty level's grid, finest first, cells never narrower than the level
         // below. At most ~4 cells per object in the whole scene (not per level: a sparse fine
         // level must not force coarse cells on the crowded levels above it).
-        let limit = (4 * objs.len()).max(64) as f64;
+        let limit = (4 * count).max(64) as f64;
         let mut floor_cell = 0.0f64;
         let mut used = Vec::new();
         for l in (0..=top).filter(|&l| occupied[l]) {
@@ -854,9 +1002,12 @@ impl<V: Vector> BroadPhase<V> {
                     .iter()
                     .enumerate()
                     .filter(move |&(_, &at)| usize::from(at) == l)
-                    .map(|(i, _)| i as u32)
+                    .filter_map(|(i, _)| {
+                        objs.prefetch(i + MEMBERS_AHEAD);
+                        Some((i as u32, objs.object(i)?))
+                    })
             };
-            floor_cell = self.levels[l].build(objs, members, topo, cell, limit, pad);
+            floor_cell = self.levels[l].build(members, topo, cell, limit, pad);
         }
         self.levels_used = used.len();
 
@@ -937,7 +1088,10 @@ impl<V: Vector> BroadPhase<V> {
                     for a in &fine_level.sorted {
                         // The cell of the exact centre, as the coarse level's members were
                         // sorted by theirs (the rounded one could fall one cell over).
-                        let c = coarse_level.coords(topo, objs[a.index() as usize].center);
+                        let Some(exact) = objs.object(a.index() as usize) else {
+                            continue;
+                        };
+                        let c = coarse_level.coords(topo, exact.center);
                         for &o in &all {
                             let Some(nk) = coarse_level.neighbour(c, o) else {
                                 continue;
@@ -1110,27 +1264,42 @@ mod tests {
                 slot: 3,
                 is_wall: false,
             };
-            let bound = Bound::new(&at(center, half), pad);
+            let bound = Bound::new(Some(&at(center, half)), pad);
             assert!(
-                bound.holds(&topo, &at(center, half)),
+                bound.holds(&topo, Some(&at(center, half))),
                 "the box it was made from"
             );
             // Moved along one axis: held well inside, never once beyond the widened box.
             let axis = DVec2::new(1.0, 0.0);
-            assert!(bound.holds(&topo, &at(center + axis * (pad - 1e-3), half)));
+            assert!(bound.holds(&topo, Some(&at(center + axis * (pad - 1e-3), half))));
             assert!(
-                bound.holds(&topo, &at(center, half * 0.5)),
+                bound.holds(&topo, Some(&at(center, half * 0.5))),
                 "shrunk in place"
             );
-            assert!(!bound.holds(&topo, &at(center - axis * (pad * (1.0 + 1e-12)), half)));
-            assert!(!bound.holds(&topo, &at(center, half + DVec2::splat(pad * 1.001))));
+            assert!(!bound.holds(
+                &topo,
+                Some(&at(center - axis * (pad * (1.0 + 1e-12)), half))
+            ));
+            assert!(!bound.holds(&topo, Some(&at(center, half + DVec2::splat(pad * 1.001)))));
             let other = BroadObject {
                 slot: 4,
                 ..at(center, half)
             };
             assert!(
-                !bound.holds(&topo, &other),
+                !bound.holds(&topo, Some(&other)),
                 "another object in the slot's place"
+            );
+            let wall = BroadObject {
+                is_wall: true,
+                ..at(center, half)
+            };
+            assert!(!bound.holds(&topo, Some(&wall)), "a wall in a disk's place");
+            assert!(!bound.holds(&topo, None), "a gap in an object's place");
+            let gap = Bound::new(None, pad);
+            assert!(gap.holds(&topo, None), "a gap in a gap's place");
+            assert!(
+                !gap.holds(&topo, Some(&at(center, half))),
+                "an object in a gap's place"
             );
         }
     }
@@ -1144,22 +1313,22 @@ mod tests {
             is_wall: wall,
         };
         let width = |o: &BroadObject<DVec2>| 2.0 * o.half.x;
-        assert_eq!(typical_width::<DVec2>(&[], width), f64::INFINITY);
+        assert_eq!(typical_width::<DVec2, [_]>(&[], width), f64::INFINITY);
         // Walls do not count, however many and however wide.
         let objs: Vec<_> = [disk(100.0, true), disk(100.0, true), disk(100.0, true)]
             .into_iter()
             .chain([1.0, 3.0, 2.0].map(|r| disk(r, false)))
             .collect();
-        assert_eq!(typical_width(&objs, width), 4.0);
+        assert_eq!(typical_width(objs.as_slice(), width), 4.0);
         // Only walls: the smallest of them.
         assert_eq!(
-            typical_width(&[disk(7.0, true), disk(5.0, true)], width),
+            typical_width(&[disk(7.0, true), disk(5.0, true)][..], width),
             10.0
         );
         // Radii 1..=100_000 in order: an even sample of about 1,000 has its median near the
         // middle, far from the smallest width (2).
         let many: Vec<_> = (1..=100_000).map(|r| disk(r as f64, false)).collect();
-        let t = typical_width(&many, width);
+        let t = typical_width(many.as_slice(), width);
         assert!((95_000.0..=105_000.0).contains(&t), "{t}");
     }
 
@@ -1330,7 +1499,7 @@ mod tests {
         assert_eq!(bp.tests, tests + whole.len() as u64);
         let exact_pairs: Vec<(u32, u32)> = whole
             .iter()
-            .filter_map(|pair| exact(&objs, &topo, pair))
+            .filter_map(|pair| exact(objs.as_slice(), &topo, pair))
             .collect();
         assert_eq!(out, exact_pairs);
         assert_eq!(found(1).1, out);

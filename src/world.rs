@@ -16,7 +16,7 @@
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
 use crate::border::{Border, Topology};
-use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode};
+use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode, Objects};
 use crate::contact::contact_wall_ball;
 use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
 use crate::critter::{
@@ -234,13 +234,9 @@ pub struct World<V: Vector> {
     pub(crate) events: StepEvents<V>,
     pub(crate) stats: StepStats,
     pub(crate) totals: StepStats,
-    pub(crate) objs: Vec<BroadObject<V>>,
     /// What the move stage did for the broad phase's input pass, which follows it at once (see
     /// [`World::stage_move`]); `None` when no move just ran.
     moved: Option<Moved>,
-    /// How many objects each chunk of [`INPUT_CHUNK`] slots gave `objs` when it was last built
-    /// on rayon's threads (empty otherwise): the parts the next move stage fills.
-    input_counts: Vec<usize>,
     pub(crate) candidates: Vec<(u32, u32)>,
     /// (caller, arg, roles still to ask the hooks for)
     pub(crate) ruled: Vec<(u32, u32, bool)>,
@@ -277,9 +273,7 @@ impl<V: Vector> World<V> {
             events: StepEvents::default(),
             stats: StepStats::default(),
             totals: StepStats::default(),
-            objs: Vec::new(),
             moved: None,
-            input_counts: Vec::new(),
             candidates: Vec::new(),
             ruled: Vec::new(),
             contacts: Vec::new(),
@@ -876,44 +870,49 @@ impl<V: Vector> World<V> {
         };
         if self.critters.len() >= PARALLEL_MIN {
             // Each chunk of slots also does the broad phase's input pass, while its critters are
-            // in cache (at a million critters that pass was two more trips through 128 MB of
-            // critters): it counts its objects and what the survey sees, and writes its objects
-            // into its part of `objs` as the last build cut them. If every chunk has as many
-            // objects as then (no critter came or went), `objs` is complete; otherwise the broad
-            // phase fills it from the counts.
+            // in cache: it surveys them and asks whether each one is still inside its bound of
+            // the Verlet list (at a million critters a pass of its own was another trip through
+            // 128 MB of critters, and the list of objects it read was 40 bytes per critter).
+            // Live walls are counted and left to the broad phase stage, which knows how far to
+            // widen their boxes only when the survey is done. The critters a few slots on are
+            // prefetched: with the check, the loop no longer kept enough loads in flight
+            // (26-28 ms against 18 per step at 1e6 on one thread, docs/performance.md).
             use rayon::prelude::*;
-            let slots = self.critters.slots_mut_moving();
-            let chunks = slots.len().div_ceil(INPUT_CHUNK);
-            let reuse = self.input_counts.len() == chunks
-                && self.input_counts.iter().sum::<usize>() == self.objs.len();
-            let parts = if reuse {
-                split_into(&mut self.objs, self.input_counts.iter().copied())
-            } else {
-                (0..chunks)
-                    .map(|_| <&mut [BroadObject<V>]>::default())
-                    .collect()
-            };
-            let seen: Vec<(usize, Survey, bool)> = slots
+            let broad = &self.broad;
+            let chunks: Vec<(Survey, bool, usize)> = self
+                .critters
+                .slots_mut_moving()
                 .par_chunks_mut(INPUT_CHUNK)
-                .zip(parts)
-                .map(|(chunk, part)| {
-                    let (mut n, mut seen) = (0, Survey::default());
-                    for c in chunk.iter_mut().flatten() {
+                .enumerate()
+                .map(|(k, chunk)| {
+                    let (mut seen, mut held, mut walls) = (Survey::default(), true, 0);
+                    for j in 0..chunk.len() {
+                        prefetch(chunk.get(j + MOVE_AHEAD));
+                        let s = &mut chunk[j];
+                        let i = k * INPUT_CHUNK + j;
+                        let Some(c) = s else {
+                            held = held && broad.list_holds(&topo, i, None);
+                            continue;
+                        };
                         step(c);
                         seen = seen.and(Survey::of(c));
-                        if let Some(o) = broad_object(c) {
-                            if let Some(slot) = part.get_mut(n) {
-                                *slot = o;
-                            }
-                            n += 1;
+                        if c.alive && c.is_wall() {
+                            walls += 1;
+                        } else {
+                            held =
+                                held && broad.list_holds(&topo, i, broad_object(c, 0.0).as_ref());
                         }
                     }
-                    (n, seen, n == part.len())
+                    (seen, held, walls)
                 })
                 .collect();
             self.moved = Some(Moved {
-                objs_filled: reuse && seen.iter().all(|&(_, _, full)| full),
-                chunks: seen.into_iter().map(|(n, s, _)| (n, s)).collect(),
+                held: chunks.iter().all(|&(_, held, _)| held),
+                walls: chunks.iter().map(|&(_, _, walls)| walls).sum(),
+                chunks: chunks.len(),
+                seen: chunks
+                    .iter()
+                    .fold(Survey::default(), |s, &(c, _, _)| s.and(c)),
             });
         } else {
             self.critters.iter_mut_moving().for_each(step);
@@ -925,40 +924,13 @@ impl<V: Vector> World<V> {
         let moved = self
             .moved
             .take()
-            .filter(|m| m.chunks.len() == self.critters.slot_count().div_ceil(INPUT_CHUNK));
-        let seen = if self.critters.len() >= PARALLEL_MIN {
-            let slots = self.critters.slot_slice();
-            let (chunks, filled) = match moved {
-                Some(m) => (m.chunks, m.objs_filled),
-                None => {
-                    let chunks = count_in_chunks(
-                        slots,
-                        |s| s.as_ref().is_some_and(|c| c.alive),
-                        |s| s.as_ref().map_or(Survey::default(), Survey::of),
-                        Survey::and,
-                    );
-                    (chunks, false)
-                }
-            };
-            if !filled {
-                fill_in_order(slots, &mut self.objs, &chunks, |s| {
-                    s.as_ref().and_then(broad_object)
-                });
-            }
-            self.input_counts.clear();
-            self.input_counts.extend(chunks.iter().map(|&(n, _)| n));
-            chunks.iter().fold(Survey::default(), |s, &(_, c)| s.and(c))
-        } else {
-            self.input_counts.clear();
-            self.objs.clear();
-            let mut seen = Survey::default();
-            for c in self.critters.iter() {
-                seen = seen.and(Survey::of(c));
-                if let Some(o) = broad_object(c) {
-                    self.objs.push(o);
-                }
-            }
-            seen
+            .filter(|m| m.chunks == self.critters.slot_count().div_ceil(INPUT_CHUNK));
+        let seen = match &moved {
+            Some(m) => m.seen,
+            None => self
+                .critters
+                .iter()
+                .fold(Survey::default(), |s, c| s.and(Survey::of(c))),
         };
         // New critters and changed priorities need their rule class (rare; sequential).
         if seen.unset {
@@ -970,21 +942,29 @@ impl<V: Vector> World<V> {
                 c.class = self.rules.class_of(&self.kinds, c);
             }
         }
-        let largest_radius = seen.largest_radius;
         // Wall pairs are tested after the disk pairs have been separated (see the response), and
         // a separation moves a disk by at most about its radius: widen walls' boxes by that much.
-        // The objects are in slot order, so each wall is found by a binary search rather than
-        // a pass over all of them.
-        for wall in &self.walls {
-            if let Ok(i) = self.objs.binary_search_by_key(&wall.index, |o| o.slot) {
-                let o = &mut self.objs[i];
-                if o.is_wall {
-                    o.half += V::splat(largest_radius);
+        let objs = Slots {
+            slots: self.critters.slot_slice(),
+            wall_pad: seen.largest_radius,
+        };
+        // The move checked every slot but the live walls' against the Verlet list; the walls
+        // are checked here, and must be the ones it counted.
+        let held = moved.map(|m| {
+            let mut walls = 0;
+            let walls_held = self.walls.iter().all(|&id| match self.critters.get(id) {
+                Some(c) if c.alive && c.is_wall() => {
+                    walls += 1;
+                    let i = id.index as usize;
+                    self.broad
+                        .list_holds(&self.topo, i, objs.object(i).as_ref())
                 }
-            }
-        }
+                _ => true,
+            });
+            m.held && walls_held && walls == m.walls
+        });
         self.broad
-            .find_pairs(&self.objs, &self.topo, &mut self.candidates);
+            .find_pairs_in(&objs, &self.topo, &mut self.candidates, held);
     }
 
     fn stage_rules(&mut self) -> Result<(), Error> {
@@ -1335,10 +1315,10 @@ fn hook_error<V: Vector>(
     }
 }
 
-/// A live critter's box for the broad phase. Only a wall's box is read from its shape, so a
-/// disk's second cache line stays untouched.
+/// A live critter's box for the broad phase, a wall's widened by `wall_pad`. Only a wall's box
+/// is read from its shape, so a disk's second cache line stays untouched.
 #[inline]
-fn broad_object<V: Vector>(c: &Critter<V>) -> Option<BroadObject<V>> {
+fn broad_object<V: Vector>(c: &Critter<V>, wall_pad: f64) -> Option<BroadObject<V>> {
     if !c.alive {
         return None;
     }
@@ -1349,9 +1329,54 @@ fn broad_object<V: Vector>(c: &Critter<V>) -> Option<BroadObject<V>> {
         is_wall: c.is_wall(),
     };
     if o.is_wall {
-        o.half = wall_half(c);
+        o.half = wall_half(c) + V::splat(wall_pad);
     }
     Some(o)
+}
+
+/// The broad phase's objects read in place from the critters' slots: index `i` is slot `i`, a
+/// gap where no live critter is.
+struct Slots<'a, V: Vector> {
+    slots: &'a [Option<Critter<V>>],
+    /// How far to widen the walls' boxes.
+    wall_pad: f64,
+}
+
+impl<V: Vector> Objects<V> for Slots<'_, V> {
+    #[inline]
+    fn slots(&self) -> usize {
+        self.slots.len()
+    }
+
+    #[inline]
+    fn object(&self, i: usize) -> Option<BroadObject<V>> {
+        self.slots
+            .get(i)?
+            .as_ref()
+            .and_then(|c| broad_object(c, self.wall_pad))
+    }
+
+    #[inline]
+    fn prefetch(&self, i: usize) {
+        prefetch(self.slots.get(i));
+    }
+}
+
+/// How many slots ahead the move asks for the next critters to be loaded.
+const MOVE_AHEAD: usize = 4;
+
+/// A hint to start loading `slot`'s first cache line (nothing for `None`).
+#[inline]
+fn prefetch<T>(slot: Option<&T>) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(slot) = slot {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch only hints the cache (it never faults, whatever the address),
+        // and SSE is in every x86_64 target.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(slot).cast()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = slot;
 }
 
 /// A wall's box half sizes.
@@ -1364,12 +1389,17 @@ fn wall_half<V: Vector>(c: &Critter<V>) -> V {
 }
 
 /// What the move stage did for the broad phase's input pass (see [`World::stage_move`]).
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 struct Moved {
-    /// Each chunk's number of objects and survey.
-    chunks: Vec<(usize, Survey)>,
-    /// True when the move also wrote every object into `objs`, in order.
-    objs_filled: bool,
+    /// How many chunks of [`INPUT_CHUNK`] slots it went through.
+    chunks: usize,
+    /// What it saw of the critters.
+    seen: Survey,
+    /// True when every slot but the live walls' was still inside its bound of the broad phase's
+    /// Verlet list.
+    held: bool,
+    /// How many live walls it passed over.
+    walls: usize,
 }
 
 /// What the broad phase's input pass learns about the critters on the way.
@@ -1405,69 +1435,6 @@ impl Survey {
 
 /// Slots per chunk of the parallel passes over the critters that build the broad phase's input.
 const INPUT_CHUNK: usize = 4096;
-
-/// For each chunk of [`INPUT_CHUNK`] items, on rayon's threads: how many pass `keep`, and their
-/// `survey`s combined with `and`. With [`fill_in_order`], a filter-map into a reused buffer
-/// whose result is the sequential one for any thread count (rayon's own unindexed collect builds
-/// fresh vectors every call and copies them together: at 100,000 critters that was page faults
-/// and copies every step).
-fn count_in_chunks<T: Sync, S: Copy + Send + Default>(
-    items: &[T],
-    keep: impl Fn(&T) -> bool + Sync,
-    survey: impl Fn(&T) -> S + Sync,
-    and: impl Fn(S, S) -> S + Sync,
-) -> Vec<(usize, S)> {
-    use rayon::prelude::*;
-    items
-        .par_chunks(INPUT_CHUNK)
-        .map(|chunk| {
-            chunk.iter().fold((0, S::default()), |(n, s), t| {
-                (n + keep(t) as usize, and(s, survey(t)))
-            })
-        })
-        .collect()
-}
-
-/// `out` = `items` filtered and mapped by `f`, in order, on rayon's threads: each chunk of
-/// [`INPUT_CHUNK`] items fills its own part of `out`, sized by `counts` (each chunk's number of
-/// items `f` maps to `Some`, from [`count_in_chunks`] or from a pass that counted the same).
-fn fill_in_order<T: Sync, U: Copy + Send, S>(
-    items: &[T],
-    out: &mut Vec<U>,
-    counts: &[(usize, S)],
-    f: impl Fn(&T) -> Option<U> + Sync,
-) {
-    use rayon::prelude::*;
-    out.clear();
-    let Some(first) = items.iter().find_map(&f) else {
-        return;
-    };
-    out.resize(counts.iter().map(|&(n, _)| n).sum(), first);
-    let parts = split_into(out, counts.iter().map(|&(n, _)| n));
-    items
-        .par_chunks(INPUT_CHUNK)
-        .zip(parts)
-        .for_each(|(chunk, part)| {
-            let mut filled = 0;
-            for (slot, u) in part.iter_mut().zip(chunk.iter().filter_map(&f)) {
-                *slot = u;
-                filled += 1;
-            }
-            debug_assert_eq!(filled, part.len(), "a chunk's count was wrong");
-        });
-}
-
-/// `items` cut into consecutive parts of the given lengths (which must not add up to more).
-fn split_into<T>(items: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
-    let mut rest = items;
-    lengths
-        .map(|n| {
-            let (part, tail) = std::mem::take(&mut rest).split_at_mut(n);
-            rest = tail;
-            part
-        })
-        .collect()
-}
 
 /// "(1, 2.5)" or "(1, 2.5, 0)".
 pub fn fmt_vec<V: Vector>(v: V) -> String {
@@ -1525,41 +1492,43 @@ mod tests {
         assert!(checked >= 5, "only {checked} steps had enough candidates");
     }
 
-    /// The broad phase's input as a fresh pass over the critters builds it.
+    /// The broad phase's objects as a fresh pass over the critters gives them.
     fn fresh_objects<V: Vector>(w: &World<V>) -> Vec<BroadObject<V>> {
-        w.critters.iter().filter_map(broad_object).collect()
+        let pad = w
+            .critters
+            .iter()
+            .filter(|c| c.alive && !c.is_wall())
+            .map(|c| c.radius)
+            .fold(0.0, f64::max);
+        w.critters
+            .iter()
+            .filter_map(|c| broad_object(c, pad))
+            .collect()
     }
 
-    /// `objs` after a step against a fresh pass, with the walls' widening taken out and the
-    /// centres of the critters the response moved (those in a contact) not compared.
-    fn check_objects<V: Vector>(w: &World<V>, what: &str) {
-        let mut objs = w.objs.clone();
-        let fresh = fresh_objects(w);
-        assert_eq!(objs.len(), fresh.len(), "{what}");
-        let touched: std::collections::BTreeSet<u32> =
-            w.contacts.iter().flat_map(|&(a, b)| [a, b]).collect();
-        for (o, f) in objs.iter_mut().zip(&fresh) {
-            if o.is_wall {
-                o.half = f.half;
-            }
-            if touched.contains(&o.slot) {
-                o.center = f.center;
-            }
-        }
-        assert!(
-            objs == fresh,
-            "{what}: the objects differ from a fresh pass"
-        );
-        assert!(
-            touched.len() < objs.len() / 10,
-            "{what}: most centres compared"
-        );
+    /// A move and a broad phase, whose pairs must be those a fresh grid finds in fresh objects;
+    /// true when the Verlet list was rebuilt.
+    fn check_pairs(w: &mut World<DVec2>, what: &str) -> bool {
+        let rebuilds = w.broad_phase_rebuilds();
+        w.stage_move(w.dt);
+        w.stage_broad_phase();
+        let mut fresh = Vec::new();
+        BroadPhase::new(BroadPhaseMode::Grid).find_pairs(&fresh_objects(w), &w.topo, &mut fresh);
+        let sorted = |pairs: &[(u32, u32)]| {
+            let mut v: Vec<_> = pairs.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(sorted(&w.candidates), sorted(&fresh), "{what}");
+        w.broad_phase_rebuilds() > rebuilds
     }
 
+    /// Above PARALLEL_MIN the move checks each critter against the Verlet list and the broad
+    /// phase the walls: a critter teleported, removed or spawned onto another, one grown, and a
+    /// wall put down across the gas each make the list be rebuilt, and the pairs are always
+    /// those of a fresh grid.
     #[test]
-    fn the_move_stage_builds_the_broad_phase_input_as_a_fresh_pass_does() {
-        // Above PARALLEL_MIN, so the move stage fills the objects; positions are read after the
-        // move, as the broad phase reads them.
+    fn the_move_s_check_of_the_verlet_list_misses_no_change() {
         let params = crate::scenes::SceneParams {
             n: Some(PARALLEL_MIN + 5000),
             ..Default::default()
@@ -1570,50 +1539,58 @@ mod tests {
         else {
             panic!("gas is 2D")
         };
-        w.step().expect("steps");
-        check_objects(&w, "first step");
-        w.step().expect("steps");
-        check_objects(&w, "second step");
-        // A critter gone (its chunk has one object fewer than the last build cut for it), then
-        // one more: the parts no longer fit, and the broad phase fills the objects itself.
-        let gone = w.critters().iter().nth(7000).expect("a critter").id;
-        w.remove(gone).expect("there");
-        w.step().expect("steps");
-        check_objects(&w, "after a removal");
-        w.spawn(CritterSpec::new("ball", DVec2::new(1.0, 1.0)))
-            .expect("spawns");
-        w.step().expect("steps");
-        check_objects(&w, "after a spawn");
-        w.step().expect("steps");
-        check_objects(&w, "a step later");
-    }
+        assert!(!w.walls.is_empty(), "the gas has walls");
+        assert!(check_pairs(&mut w, "first step"), "the first step builds");
+        assert!(
+            !check_pairs(&mut w, "second step"),
+            "a quiet step keeps the list"
+        );
+        let disks: Vec<CritterId> = w
+            .critters()
+            .iter()
+            .filter(|c| !c.is_wall())
+            .map(|c| c.id())
+            .collect();
+        let (a, b, c) = (disks[100], disks[20_000], disks[7000]);
 
-    #[test]
-    fn count_and_fill_match_the_sequential_filter_map_on_any_thread_count() {
-        // Sizes around the chunk size; the survey (a sum of the items) must match too.
-        for n in [0usize, 1, 7, 4095, 4096, 4097, 12_289] {
-            // Keep every item, every third, every thousandth, or none (0).
-            for keep_every in [1usize, 3, 1000, 0] {
-                let items: Vec<usize> = (0..n).collect();
-                let f =
-                    |&i: &usize| (keep_every > 0 && i % keep_every == 0).then_some(i as u64 * 3);
-                let expected: Vec<u64> = items.iter().filter_map(f).collect();
-                for threads in [1, 3] {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .expect("a pool");
-                    let mut out = vec![99u64; 5]; // stale contents must not survive
-                    let sum = pool.install(|| {
-                        let keep = |i: &usize| f(i).is_some();
-                        let counts = count_in_chunks(&items, keep, |&i| i, |a, b| a + b);
-                        fill_in_order(&items, &mut out, &counts, f);
-                        counts.iter().map(|&(_, s)| s).sum::<usize>()
-                    });
-                    assert_eq!(out, expected, "n {n}, keep every {keep_every}");
-                    assert_eq!(sum, n * n.saturating_sub(1) / 2, "n {n}");
-                }
-            }
-        }
+        let there = w.get(b).expect("there").pos;
+        w.get_mut(a).expect("there").pos = there;
+        assert!(check_pairs(&mut w, "a teleport"));
+        assert!(w
+            .candidates
+            .iter()
+            .any(|&(p, q)| [p, q] == [a.index, b.index] || [q, p] == [a.index, b.index]));
+        assert!(!check_pairs(&mut w, "a quiet step"));
+
+        w.remove(c).expect("there");
+        assert!(check_pairs(&mut w, "a removal"));
+        let there = w.get(b).expect("there").pos;
+        let spawned = w.spawn(CritterSpec::new("ball", there)).expect("spawns");
+        assert_eq!(spawned.index, c.index, "the freed slot is reused");
+        assert!(check_pairs(&mut w, "a spawn onto a critter"));
+        assert!(!check_pairs(&mut w, "a quiet step"));
+
+        w.get_mut(disks[300]).expect("there").radius *= 4.0;
+        assert!(check_pairs(&mut w, "a critter grown"));
+
+        // A wall in a freed slot: only the broad phase's check of the walls sees it.
+        w.remove(disks[400]).expect("there");
+        assert!(check_pairs(&mut w, "a removal"));
+        let middle = 0.5 * (w.topo.min + w.topo.max);
+        let wall = WallBox::aligned(
+            middle - DVec2::new(20.0, 0.5),
+            middle + DVec2::new(20.0, 0.5),
+        )
+        .expect("a wall");
+        let id = w.add_wall(wall).expect("added");
+        assert_eq!(id.index, disks[400].index, "the freed slot is reused");
+        let slots = w.critters.slot_count();
+        assert!(check_pairs(&mut w, "a wall put down"));
+        assert_eq!(w.critters.slot_count(), slots);
+        assert!(w
+            .candidates
+            .iter()
+            .any(|&(p, q)| p == id.index || q == id.index));
+        assert!(!check_pairs(&mut w, "a quiet step"));
     }
 }
