@@ -426,8 +426,18 @@ impl<V: Vector> Level<V> {
 /// Objects per run of cells walked by one task when a level's pairs are found in parallel.
 const RUN_OBJECTS: usize = 8192;
 
-/// The skin of the Verlet list, as a fraction of the objects' typical width.
-const SKIN: f64 = 0.4;
+/// The skin of the Verlet list, as a fraction of the objects' typical width: 0.6 in 2D, 0.4 in
+/// 3D. A larger skin means fewer rebuilds and more kept pairs to re-test; in 2D 0.6 against 0.4
+/// made the settled gas 2-10 % faster from 1e4 to 1e6 for about 6 bytes per critter more, in 3D
+/// (where the kept pairs grow with the cube of the reach) it saved no time and cost 15 bytes
+/// per critter at 2e5 and 50 at 1e6 (docs/performance.md).
+fn skin<V: Vector>() -> f64 {
+    if V::DIM == 2 {
+        0.6
+    } else {
+        0.4
+    }
+}
 
 /// Most objects sampled for the typical width.
 const WIDTH_SAMPLES: usize = 1024;
@@ -852,7 +862,7 @@ impl<V: Vector> BroadPhase<V> {
     fn rebuild_list<O: Objects<V> + ?Sized>(&mut self, objs: &O, topo: &Topology<V>) {
         let width =
             |o: &BroadObject<V>| (0..V::DIM).map(|a| 2.0 * o.half.get(a)).fold(0.0, f64::max);
-        let skin = SKIN * typical_width(objs, width);
+        let skin = skin::<V>() * typical_width(objs, width);
         // Boxes widened by half the skin, pairs named by index so they index `objs`.
         let mut pairs = std::mem::take(&mut self.list.pairs);
         pairs.clear();
