@@ -40,7 +40,7 @@ pub struct BroadObject<V> {
 /// Where the broad phase reads its objects: indices `0..slots()`, each an object or a gap (a
 /// slot with no live critter). Pairs are reported by the objects' `slot`s. A slice of objects is
 /// one; the world reads its critters' slots in place, so no list of objects is kept per step.
-pub trait Objects<V: Vector>: Sync {
+pub(crate) trait Objects<V: Vector>: Sync {
     /// How many indices there are.
     fn slots(&self) -> usize;
     /// The object at index `i < slots()`, or `None` for a gap.
