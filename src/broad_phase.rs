@@ -982,17 +982,14 @@ impl<V: Vector> BroadPhase<V> {
         } else {
             self.level_of.extend((0..n).map(level));
         }
-        let (mut top, mut count) = (0usize, 0usize);
+        let (mut top, mut count, mut occupied) = (0usize, 0usize, [false; 64]);
         for &l in self.level_of.iter().filter(|&&l| l != NO_LEVEL) {
             top = top.max(usize::from(l));
             count += 1;
+            occupied[usize::from(l)] = true;
         }
         if self.levels.len() < top + 1 {
             self.levels.resize_with(top + 1, Level::default);
-        }
-        let mut occupied = [false; 64];
-        for &l in self.level_of.iter().filter(|&&l| l != NO_LEVEL) {
-            occupied[l as usize] = true;
         }
 
         // Build each non-empty level's grid, finest first, cells never narrower than the level
