@@ -158,9 +158,11 @@ pub struct StepStats {
     pub moving: Duration,
     /// Broad phase.
     pub broad_phase: Duration,
-    /// Roles.
+    /// Roles, when asked in a stage of their own: only in steps where some candidate's rule is
+    /// not in the class table yet or a touching pair's roles depend on state (a script is run);
+    /// otherwise the narrow phase's pass asks them and its time is in `narrow_phase`.
     pub rules: Duration,
-    /// Narrow phase.
+    /// Narrow phase (with the rules in the same pass, see `rules`), and the sort of the contacts.
     pub narrow_phase: Duration,
     /// Response.
     pub response: Duration,
@@ -801,15 +803,22 @@ impl<V: Vector> World<V> {
         };
         self.stage_broad_phase();
         lap(&mut stats.broad_phase);
-        self.stage_rules()?;
-        lap(&mut stats.rules);
-        self.stage_narrow_phase()?;
+        let ruled = match self.rules_and_narrow_phase_in_one_pass() {
+            Some(ruled) => ruled,
+            None => {
+                self.stage_rules()?;
+                lap(&mut stats.rules);
+                self.stage_narrow_phase()?;
+                self.ruled.len()
+            }
+        };
+        self.sort_contacts();
         lap(&mut stats.narrow_phase);
         let collisions = self.stage_response()?;
         lap(&mut stats.response);
         stats.pair_tests += self.broad.tests;
         stats.candidates += self.candidates.len();
-        stats.ruled += self.ruled.len();
+        stats.ruled += ruled;
         stats.contacts += self.contacts.len();
         stats.collisions += collisions;
         Ok(())
@@ -969,12 +978,6 @@ impl<V: Vector> World<V> {
 
     fn stage_rules(&mut self) -> Result<(), Error> {
         self.ruled.clear();
-        if self.candidates.len() >= PARALLEL_PAIRS
-            && rayon::current_num_threads() > 1
-            && self.rules_in_parallel()
-        {
-            return Ok(());
-        }
         self.rules_in_order()
     }
 
@@ -1001,101 +1004,96 @@ impl<V: Vector> World<V> {
         Ok(())
     }
 
-    /// The rules stage in parallel chunks of candidates, joined in order (the same `ruled` for
-    /// any thread count), when every candidate's rule is already in the class table: the
-    /// stage's time is the critters' cache misses, which two cores wait for side by side. False,
-    /// with `ruled` left empty, if some pair's rule is still to be computed (that may run a
-    /// script, one at a time).
-    fn rules_in_parallel(&mut self) -> bool {
-        use rayon::prelude::*;
-        let (critters, rules) = (&self.critters, &self.rules);
-        let parts: Vec<Option<Vec<(u32, u32, bool)>>> = self
-            .candidates
-            .par_chunks(INPUT_CHUNK)
-            .map(|chunk| {
-                let mut part = Vec::with_capacity(chunk.len());
-                for &(a, b) in chunk {
-                    let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
-                        continue;
-                    };
-                    match rules.cached(ca.class, cb.class)? {
-                        Some(rule) => {
-                            if let Some((caller, arg)) = roles_order(rule, ca, cb) {
-                                part.push((caller.id.index, arg.id.index, false));
-                            }
-                        }
-                        None => part.push((a, b, true)),
-                    }
-                }
-                Some(part)
-            })
-            .collect();
-        if parts.iter().any(Option::is_none) {
-            return false;
-        }
-        for part in parts.into_iter().flatten() {
-            self.ruled.extend(part);
-        }
-        true
-    }
-
     fn stage_narrow_phase(&mut self) -> Result<(), Error> {
         self.contacts.clear();
         self.wall_pairs.clear();
-        if self.ruled.len() < PARALLEL_PAIRS
-            || rayon::current_num_threads() == 1
-            || !self.narrow_phase_in_parallel()
-        {
-            self.narrow_phase_in_order()?;
-        }
-        self.contacts
-            .sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
-        self.wall_pairs
-            .sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
-        Ok(())
+        self.narrow_phase_in_order()
     }
 
-    /// The narrow phase in parallel chunks of pairs, joined in order, when no touching pair's
-    /// roles are still to be asked (asking may run a script). False, with nothing written,
-    /// otherwise. The lists are sorted afterwards, and no pair is in them twice, so their order
-    /// is the sequential pass's.
-    fn narrow_phase_in_parallel(&mut self) -> bool {
+    /// The contacts and wall pairs in the order of their lower slot, then their higher one: the
+    /// order the response takes them in, whatever order the broad phase found them in.
+    fn sort_contacts(&mut self) {
+        sort_pairs(&mut self.contacts, self.critters.slot_count());
+        let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+        self.wall_pairs.sort_unstable_by_key(|&(c, a, _)| key(c, a));
+    }
+
+    /// The rules and narrow stages in one pass over the candidates, which reads each pair's
+    /// critters once instead of once per stage, when every candidate's rule is already in the
+    /// class table and no touching disk pair's roles are still to be asked (the rules would run
+    /// a script). Returns how many pairs may collide, or `None`, with the lists to be redone,
+    /// otherwise. With [`PARALLEL_PAIRS`] candidates or more and more than one thread the pass
+    /// runs in chunks of [`INPUT_CHUNK`] pairs on all cores, joined in order, so the lists are
+    /// the same for any thread count, and the same as the two stages one after the other.
+    fn rules_and_narrow_phase_in_one_pass(&mut self) -> Option<usize> {
         use rayon::prelude::*;
-        type Part = (Vec<(u32, u32)>, Vec<(u32, u32, bool)>);
-        let (critters, topo) = (&self.critters, &self.topo);
-        let parts: Vec<Option<Part>> = self
-            .ruled
+        let (critters, rules, topo) = (&self.critters, &self.rules, &self.topo);
+        let slots = critters.slot_slice();
+        let pass = |chunk: &[(u32, u32)],
+                    contacts: &mut Vec<(u32, u32)>,
+                    walls: &mut Vec<(u32, u32, bool)>|
+         -> Option<usize> {
+            let mut ruled = 0;
+            for (k, &(a, b)) in chunk.iter().enumerate() {
+                if let Some(&(i, j)) = chunk.get(k + CANDIDATES_AHEAD) {
+                    prefetch(slots.get(i as usize));
+                    prefetch(slots.get(j as usize));
+                }
+                let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
+                    continue;
+                };
+                let (first, second, ask) = match rules.cached(ca.class, cb.class)? {
+                    Some(rule) => match roles_order(rule, ca, cb) {
+                        Some((caller, arg)) => (caller, arg, false),
+                        None => continue,
+                    },
+                    None => (ca, cb, true),
+                };
+                ruled += 1;
+                let pair = (first.id.index, second.id.index);
+                if first.is_wall() || second.is_wall() {
+                    // Tested in the response, once the disk pairs have moved.
+                    walls.push((pair.0, pair.1, ask));
+                } else if crate::contact::touching_ball_ball(
+                    topo.delta(first.pos, second.pos),
+                    first.radius,
+                    second.radius,
+                ) {
+                    if ask {
+                        return None;
+                    }
+                    contacts.push(pair);
+                }
+            }
+            Some(ruled)
+        };
+        self.contacts.clear();
+        self.wall_pairs.clear();
+        if self.candidates.len() < PARALLEL_PAIRS || rayon::current_num_threads() == 1 {
+            let ruled = pass(&self.candidates, &mut self.contacts, &mut self.wall_pairs);
+            if ruled.is_none() {
+                self.contacts.clear();
+                self.wall_pairs.clear();
+            }
+            return ruled;
+        }
+        type Part = (usize, Vec<(u32, u32)>, Vec<(u32, u32, bool)>);
+        let parts: Vec<Part> = self
+            .candidates
             .par_chunks(INPUT_CHUNK)
             .map(|chunk| {
                 let (mut contacts, mut walls) = (Vec::new(), Vec::new());
-                for &(first, second, ask) in chunk {
-                    let (Some(a), Some(b)) = (critters.slot(first), critters.slot(second)) else {
-                        continue;
-                    };
-                    if a.is_wall() || b.is_wall() {
-                        walls.push((first, second, ask));
-                    } else if crate::contact::touching_ball_ball(
-                        topo.delta(a.pos, b.pos),
-                        a.radius,
-                        b.radius,
-                    ) {
-                        if ask {
-                            return None;
-                        }
-                        contacts.push((first, second));
-                    }
-                }
-                Some((contacts, walls))
+                let ruled = pass(chunk, &mut contacts, &mut walls)?;
+                Some((ruled, contacts, walls))
             })
-            .collect();
-        if parts.iter().any(Option::is_none) {
-            return false;
-        }
-        for (contacts, walls) in parts.into_iter().flatten() {
+            .collect::<Option<_>>()?;
+        let mut ruled = 0;
+        for (n, contacts, walls) in parts {
+            ruled += n;
             self.contacts.extend(contacts);
             self.wall_pairs.extend(walls);
         }
-        true
+        Some(ruled)
     }
 
     /// The narrow phase, one pair after another.
@@ -1131,7 +1129,12 @@ impl<V: Vector> World<V> {
     fn stage_response(&mut self) -> Result<usize, Error> {
         let mut collisions = 0;
         let disk_contacts = std::mem::take(&mut self.contacts);
-        for &(caller, arg) in &disk_contacts {
+        for (k, &(caller, arg)) in disk_contacts.iter().enumerate() {
+            if let Some(&(i, j)) = disk_contacts.get(k + CANDIDATES_AHEAD) {
+                let slots = self.critters.slot_slice();
+                prefetch(slots.get(i as usize));
+                prefetch(slots.get(j as usize));
+            }
             if self.collide_pair(caller, arg)? {
                 collisions += 1;
             }
@@ -1362,6 +1365,58 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
     }
 }
 
+/// Lists of fewer pairs than this are sorted by comparison; longer ones (a pile's contacts)
+/// by radix.
+const RADIX_MIN: usize = 256;
+
+/// Bits per digit of the radix sort of pairs.
+const RADIX_BITS: u32 = 11;
+
+/// Sorts `pairs` of slots below `slots` by their lower slot, then their higher one, keeping
+/// each pair's own order; no pair may be in the list twice (as `(a, b)` and `(b, a)` either).
+/// Each pair becomes one integer (lower slot, higher slot, then a bit for "the first is the
+/// higher"), sorted a digit at a time from the lowest: a pile's 100,000 contacts in a few
+/// passes over them instead of a comparison sort's 17.
+fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) {
+    let bits = usize::BITS - slots.saturating_sub(1).leading_zeros();
+    let width = 2 * bits + 1;
+    let key = |&(a, b): &(u32, u32)| {
+        (u64::from(a.min(b)) << (bits + 1)) | (u64::from(a.max(b)) << 1) | u64::from(a > b)
+    };
+    if pairs.len() < RADIX_MIN || width > u64::BITS {
+        pairs.sort_unstable_by_key(|&(a, b)| (a.min(b), a.max(b)));
+        return;
+    }
+    let mut keys: Vec<u64> = pairs.iter().map(key).collect();
+    let mut spare = vec![0u64; keys.len()];
+    let mask = (1u64 << RADIX_BITS) - 1;
+    for shift in (0..width).step_by(RADIX_BITS as usize) {
+        let mut start = [0usize; 1 << RADIX_BITS];
+        for &k in &keys {
+            start[((k >> shift) & mask) as usize] += 1;
+        }
+        let mut sum = 0;
+        for s in &mut start {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for &k in &keys {
+            let d = ((k >> shift) & mask) as usize;
+            spare[start[d]] = k;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut keys, &mut spare);
+    }
+    let slot_mask = (1u64 << bits) - 1;
+    for (pair, k) in pairs.iter_mut().zip(keys) {
+        let (lo, hi) = ((k >> (bits + 1)) as u32, ((k >> 1) & slot_mask) as u32);
+        *pair = if k & 1 == 1 { (hi, lo) } else { (lo, hi) };
+    }
+}
+
+/// How many pairs ahead the rules and narrow stages' pass and the response ask for the critters
+/// of the next pairs to be loaded (they are scattered over memory, and the loads overlap).
+const CANDIDATES_AHEAD: usize = 8;
+
 /// How many slots ahead the move asks for the next critters to be loaded.
 const MOVE_AHEAD: usize = 4;
 
@@ -1447,49 +1502,86 @@ mod tests {
     use super::*;
     use glam::DVec2;
 
-    /// The parallel rules and narrow phase give the lists of the sequential ones, on a gas with
-    /// walls that has settled into many candidate pairs.
+    /// The rules and narrow stages in one pass give the lists of the two stages one after the
+    /// other, on one thread and in parallel chunks, on a gas with walls that has settled into
+    /// many candidate pairs.
     #[test]
-    fn rules_and_narrow_phase_in_parallel_match_them_in_order() {
-        let mut w = crate::scenes::gas::<DVec2>(&crate::scenes::GasParams {
-            n: 40_000,
-            packing: 0.45,
-            ..Default::default()
-        })
-        .unwrap();
-        let mut checked = 0;
-        for _ in 0..30 {
-            w.step().unwrap();
-            w.stage_broad_phase();
-            if w.candidates.len() < INPUT_CHUNK {
-                continue;
+    fn rules_and_narrow_phase_in_one_pass_match_them_one_after_the_other() {
+        let check = || {
+            let mut w = crate::scenes::gas::<DVec2>(&crate::scenes::GasParams {
+                n: 40_000,
+                packing: 0.45,
+                ..Default::default()
+            })
+            .unwrap();
+            let mut checked = 0;
+            for _ in 0..30 {
+                w.step().unwrap();
+                w.stage_broad_phase();
+                if w.candidates.len() < PARALLEL_PAIRS {
+                    continue;
+                }
+                w.stage_rules().unwrap();
+                w.stage_narrow_phase().unwrap();
+                w.sort_contacts();
+                let in_order = (w.ruled.len(), w.contacts.clone(), w.wall_pairs.clone());
+                assert!(!in_order.1.is_empty() && !in_order.2.is_empty());
+                let ruled = w.rules_and_narrow_phase_in_one_pass();
+                w.sort_contacts();
+                let fused = (
+                    ruled.expect("no roles to ask"),
+                    w.contacts.clone(),
+                    w.wall_pairs.clone(),
+                );
+                assert_eq!(fused, in_order);
+                checked += 1;
             }
-            w.ruled.clear();
-            w.rules_in_order().unwrap();
-            let in_order = w.ruled.clone();
-            w.ruled.clear();
-            assert!(w.rules_in_parallel(), "every class pair is in the table");
-            assert_eq!(w.ruled, in_order);
-
-            let sorted = |w: &World<DVec2>| {
-                let mut c = w.contacts.clone();
-                c.sort_unstable_by_key(|&(c, a)| (c.min(a), c.max(a)));
-                let mut p = w.wall_pairs.clone();
-                p.sort_unstable_by_key(|&(c, a, _)| (c.min(a), c.max(a)));
-                (c, p)
-            };
-            w.contacts.clear();
-            w.wall_pairs.clear();
-            w.narrow_phase_in_order().unwrap();
-            let in_order = sorted(&w);
-            w.contacts.clear();
-            w.wall_pairs.clear();
-            assert!(w.narrow_phase_in_parallel(), "no pair's roles are asked");
-            assert_eq!(sorted(&w), in_order);
-            assert!(!in_order.0.is_empty() && !in_order.1.is_empty());
-            checked += 1;
+            checked
+        };
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let checked = pool.install(check);
+            assert!(checked >= 5, "only {checked} steps had enough candidates");
         }
-        assert!(checked >= 5, "only {checked} steps had enough candidates");
+    }
+
+    /// The radix sort of pairs gives the comparison sort's order, each pair kept the way round
+    /// it was, for slot counts from a handful to 2^31 (where the key no longer fits and the
+    /// comparison sort takes over).
+    #[test]
+    fn pairs_sorted_by_radix_are_in_the_comparison_sort_s_order() {
+        let mut rng = crate::Rng::new(11);
+        for (slots, n) in [
+            (3, 2),
+            (40, 300),
+            (10_004, 20_000),
+            (1 << 20, 5_000),
+            (1 << 31, 600),
+        ] {
+            let mut seen = std::collections::BTreeSet::new();
+            let mut pairs = Vec::new();
+            while pairs.len() < n {
+                let a = (rng.next_f64() * slots as f64) as u32;
+                let b = (rng.next_f64() * slots as f64) as u32;
+                if a != b && seen.insert((a.min(b), a.max(b))) {
+                    pairs.push((a, b));
+                }
+            }
+            let mut expected = pairs.clone();
+            expected.sort_by_key(|&(a, b)| (a.min(b), a.max(b)));
+            sort_pairs(&mut pairs, slots);
+            assert_eq!(pairs, expected, "{slots} slots");
+            if n > 100 {
+                let ways = |first_higher: bool| pairs.iter().any(|&(a, b)| (a > b) == first_higher);
+                assert!(
+                    ways(true) && ways(false),
+                    "test setup: pairs both ways round"
+                );
+            }
+        }
     }
 
     /// The broad phase's objects as a fresh pass over the critters gives them.

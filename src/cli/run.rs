@@ -354,6 +354,15 @@ fn stats(
         ("lifecycle", t.lifecycle),
         ("total", t.total()),
     ] {
+        if stage == "rules" {
+            // See `StepStats::rules`.
+            writeln!(
+                out,
+                "  {stage:<12} {:.4} (steps with a rule to compute; else in the narrow phase)",
+                per(d)
+            )?;
+            continue;
+        }
         writeln!(out, "  {stage:<12} {:.4}", per(d))?;
     }
     if let Some(r) = recording {
