@@ -956,6 +956,7 @@ impl<V: Vector> World<V> {
         let objs = Slots {
             slots: self.critters.slot_slice(),
             wall_pad: seen.largest_radius,
+            dt: self.dt,
         };
         // The move checked every slot but the live walls' against the Verlet list; the walls
         // are checked here, and must be the ones it counted.
@@ -1343,6 +1344,8 @@ struct Slots<'a, V: Vector> {
     slots: &'a [Option<Critter<V>>],
     /// How far to widen the walls' boxes.
     wall_pad: f64,
+    /// The step's length, for the critters' strides.
+    dt: f64,
 }
 
 impl<V: Vector> Objects<V> for Slots<'_, V> {
@@ -1362,6 +1365,14 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
     #[inline]
     fn prefetch(&self, i: usize) {
         prefetch(self.slots.get(i));
+    }
+
+    #[inline]
+    fn stride(&self, i: usize) -> f64 {
+        match self.slots.get(i) {
+            Some(Some(c)) if c.alive && !c.fixed && !c.is_wall() => c.vel.length() * self.dt,
+            _ => 0.0,
+        }
     }
 }
 
