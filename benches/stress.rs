@@ -138,11 +138,12 @@ fn stress(c: &mut Criterion) {
         });
         let stats = world.stats();
         eprintln!(
-            "{name}: {} critters, {} contacts and {} pair tests in the last step, {} list rebuilds",
+            "{name}: {} critters, {} contacts and {} pair tests in the last step, {} list rebuilds, {} repairs",
             world.critters().len(),
             stats.contacts,
             stats.pair_tests,
-            world.broad_phase_rebuilds()
+            world.broad_phase_rebuilds(),
+            world.broad_phase_repairs()
         );
     }
     group.finish();

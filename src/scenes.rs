@@ -105,6 +105,10 @@ impl AnyWorld {
     pub fn broad_phase_rebuilds(&self) -> u64 {
         both!(self, w => w.broad_phase_rebuilds())
     }
+    /// How many times the broad phase mended its Verlet list instead of rebuilding it.
+    pub fn broad_phase_repairs(&self) -> u64 {
+        both!(self, w => w.broad_phase_repairs())
+    }
     /// Changes the time step.
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         both!(self, w => w.set_dt(dt))

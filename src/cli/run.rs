@@ -377,8 +377,9 @@ fn stats(
     if rebuilds > 0 {
         writeln!(
             out,
-            "pair list    rebuilt {rebuilds} times (every {:.1} steps)",
-            steps as f64 / rebuilds as f64
+            "pair list    rebuilt {rebuilds} times (every {:.1} steps), mended {} times",
+            steps as f64 / rebuilds as f64,
+            world.broad_phase_repairs()
         )?;
     }
     if let Some(peak) = peak_rss_bytes() {
