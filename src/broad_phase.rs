@@ -921,7 +921,8 @@ impl<V: Vector> BroadPhase<V> {
     /// Auto mode's pairs for large scenes: a Verlet list. The grid is built with every box
     /// widened by half a skin, and the pairs it finds are kept; while no object has moved more
     /// than half the skin from where it was then (and none came, went or changed size), every
-    /// overlapping pair is among them, so a step only re-tests the kept pairs.
+    /// overlapping pair is among them, so a step only re-tests the kept pairs. When a few have,
+    /// the list is mended for them (`repair_list`) rather than built anew.
     fn listed_pairs<O: Objects<V> + ?Sized>(
         &mut self,
         objs: &O,
