@@ -276,6 +276,30 @@ impl<V: Vector> Level<V> {
         out
     }
 
+    /// How many cells [`Self::footprint`] gives for `b`.
+    fn footprint_cells(&self, topo: &Topology<V>, b: &CellBox<V>) -> f64 {
+        self.footprint(topo, b).iter().map(|r| r.1 as f64).product()
+    }
+
+    /// Calls `f` with each member of the cells of `b`'s footprint: every member whose box may
+    /// overlap `b`'s.
+    #[inline]
+    fn for_each_near(&self, topo: &Topology<V>, b: &CellBox<V>, mut f: impl FnMut(&CellBox<V>)) {
+        let ranges = self.footprint(topo, b);
+        for k in 0..ranges[2].1 {
+            for j in 0..ranges[1].1 {
+                for i in 0..ranges[0].1 {
+                    let c = [
+                        self.axis_cell(0, ranges[0].0 + i as i64),
+                        self.axis_cell(1, ranges[1].0 + j as i64),
+                        self.axis_cell(2, ranges[2].0 + k as i64),
+                    ];
+                    self.cell(self.key(c)).iter().for_each(&mut f);
+                }
+            }
+        }
+    }
+
     /// Cell index `i` along `axis`, wrapped on periodic axes (in range otherwise).
     #[inline]
     fn axis_cell(&self, axis: usize, i: i64) -> usize {
@@ -1048,12 +1072,7 @@ impl<V: Vector> BroadPhase<V> {
         let mut work = (e * (e + x)) as f64;
         for b in fresh.iter().filter_map(|(_, b)| b.as_ref()) {
             for &l in &self.used {
-                let cells: f64 = self.levels[l]
-                    .footprint(topo, b)
-                    .iter()
-                    .map(|r| r.1 as f64)
-                    .product();
-                work += cells;
+                work += self.levels[l].footprint_cells(topo, b);
             }
         }
         if work > REPAIR_WORK * n as f64 {
@@ -1075,26 +1094,11 @@ impl<V: Vector> BroadPhase<V> {
                 continue;
             };
             for &l in &self.used {
-                let level = &self.levels[l];
-                let ranges = level.footprint(topo, &b);
-                for k in 0..ranges[2].1 {
-                    for j in 0..ranges[1].1 {
-                        for c in 0..ranges[0].1 {
-                            let cell = [
-                                level.axis_cell(0, ranges[0].0 + c as i64),
-                                level.axis_cell(1, ranges[1].0 + j as i64),
-                                level.axis_cell(2, ranges[2].0 + k as i64),
-                            ];
-                            for a in level.cell(level.key(cell)) {
-                                if !bit(&list.moved, a.index() as usize)
-                                    && cells_overlap(topo, a, &b)
-                                {
-                                    list.pairs.push((a.index(), i));
-                                }
-                            }
-                        }
+                self.levels[l].for_each_near(topo, &b, |a| {
+                    if !bit(&list.moved, a.index() as usize) && cells_overlap(topo, a, &b) {
+                        list.pairs.push((a.index(), i));
                     }
-                }
+                });
             }
             for a in &list.extras {
                 if cells_overlap(topo, a, &b) {
@@ -1307,34 +1311,16 @@ impl<V: Vector> BroadPhase<V> {
                 let by_coarse: f64 = coarse_level
                     .sorted
                     .iter()
-                    .map(|b| {
-                        fine_level
-                            .footprint(topo, b)
-                            .iter()
-                            .map(|r| r.1 as f64)
-                            .product::<f64>()
-                    })
+                    .map(|b| fine_level.footprint_cells(topo, b))
                     .sum();
                 if by_coarse < by_fine {
                     for b in &coarse_level.sorted {
-                        let ranges = fine_level.footprint(topo, b);
-                        for k in 0..ranges[2].1 {
-                            for j in 0..ranges[1].1 {
-                                for i in 0..ranges[0].1 {
-                                    let c = [
-                                        fine_level.axis_cell(0, ranges[0].0 + i as i64),
-                                        fine_level.axis_cell(1, ranges[1].0 + j as i64),
-                                        fine_level.axis_cell(2, ranges[2].0 + k as i64),
-                                    ];
-                                    for a in fine_level.cell(fine_level.key(c)) {
-                                        self.tests += 1;
-                                        if cells_overlap(topo, a, b) {
-                                            out.push((a.index(), b.index()));
-                                        }
-                                    }
-                                }
+                        fine_level.for_each_near(topo, b, |a| {
+                            self.tests += 1;
+                            if cells_overlap(topo, a, b) {
+                                out.push((a.index(), b.index()));
                             }
-                        }
+                        });
                     }
                 } else {
                     let all = coarse_level.offsets(false);
