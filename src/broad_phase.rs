@@ -539,44 +539,41 @@ fn typical_width<V: Vector, O: Objects<V> + ?Sized>(
     objs: &O,
     width: impl Fn(&BroadObject<V>) -> f64,
 ) -> f64 {
-    let n = objs.slots();
-    let step = n.div_ceil(WIDTH_SAMPLES).max(1);
-    let mut sample = [0.0f64; WIDTH_SAMPLES];
-    let mut taken = 0;
-    for o in (0..n).step_by(step).filter_map(|i| objs.object(i)) {
-        if !o.is_wall {
-            sample[taken] = width(&o);
-            taken += 1;
-        }
-    }
-    if taken == 0 {
-        return (0..n)
+    sample_median(objs, |_, o| width(o)).unwrap_or_else(|| {
+        (0..objs.slots())
             .filter_map(|i| objs.object(i))
             .map(|o| width(&o))
-            .fold(f64::INFINITY, f64::min);
-    }
-    let (_, median, _) = sample[..taken].select_nth_unstable_by(taken / 2, f64::total_cmp);
-    *median
+            .fold(f64::INFINITY, f64::min)
+    })
 }
 
-/// The median stride of the objects that are not walls among the same sample as
-/// [`typical_width`]'s (0 for none).
-fn typical_stride<V: Vector, O: Objects<V> + ?Sized>(objs: &O) -> f64 {
+/// The median of `value(i, object)` over the objects that are not walls among up to
+/// [`WIDTH_SAMPLES`] indices spread evenly over `objs`; `None` when there are none.
+fn sample_median<V: Vector, O: Objects<V> + ?Sized>(
+    objs: &O,
+    value: impl Fn(usize, &BroadObject<V>) -> f64,
+) -> Option<f64> {
     let n = objs.slots();
     let step = n.div_ceil(WIDTH_SAMPLES).max(1);
     let mut sample = [0.0f64; WIDTH_SAMPLES];
     let mut taken = 0;
     for i in (0..n).step_by(step) {
-        if objs.object(i).is_some_and(|o| !o.is_wall) {
-            sample[taken] = objs.stride(i);
+        if let Some(o) = objs.object(i).filter(|o| !o.is_wall) {
+            sample[taken] = value(i, &o);
             taken += 1;
         }
     }
     if taken == 0 {
-        return 0.0;
+        return None;
     }
     let (_, median, _) = sample[..taken].select_nth_unstable_by(taken / 2, f64::total_cmp);
-    *median
+    Some(*median)
+}
+
+/// The median stride of the objects that are not walls among the same sample as
+/// [`typical_width`]'s (0 for none).
+fn typical_stride<V: Vector, O: Objects<V> + ?Sized>(objs: &O) -> f64 {
+    sample_median(objs, |i, _| objs.stride(i)).unwrap_or(0.0)
 }
 
 /// Where one index's object may be while the Verlet list stays valid: its box at the build widened
