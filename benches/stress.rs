@@ -7,7 +7,8 @@
 //!   every step instead of the Verlet list);
 //! * `pile_9_layers`, `pile_90_layers`: disks of radius 0.5 dropped under gravity (restitution
 //!   0.5) in a box 1000 or 100 wide and settled for 900 steps into a pile about 9 or 90 layers
-//!   deep, so nearly every disk touches its neighbours.
+//!   deep, so nearly every disk touches its neighbours (and `pile_9_layers_solve_8`, the
+//!   9-layer pile dropped, settled and stepped under `solve:8`, its contacts solved together).
 //!
 //! `cargo bench --bench stress`; `docs/performance.md` has the figures. The target is each
 //! scene within 3x of the uniform gas per critter.
@@ -16,7 +17,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use critterbox::glam::DVec2;
 use critterbox::scenes::{gas, GasParams};
 use critterbox::wall::DEFAULT_WALL_THICKNESS;
-use critterbox::{BroadPhaseMode, CritterSpec, Rng, WallBox, World, WorldConfig};
+use critterbox::{BroadPhaseMode, CritterSpec, Method, Rng, WallBox, World, WorldConfig};
 use std::f64::consts::PI;
 use std::time::Duration;
 
@@ -100,11 +101,17 @@ fn radii_x100_with(mode: BroadPhaseMode) -> World<DVec2> {
 /// Disks of radius 0.5 on a loose grid (spacing 1.5) in a box `w` wide, dropped under gravity
 /// with restitution 0.5 and settled for 900 steps.
 fn pile(w: f64) -> World<DVec2> {
+    pile_under(w, Method::Discrete)
+}
+
+/// [`pile`], dropped, settled and stepped under `method`.
+fn pile_under(w: f64, method: Method) -> World<DVec2> {
     let spacing = 1.5;
     let per_row = (w / spacing) as usize;
     let rows = N.div_ceil(per_row);
     let h = rows as f64 * spacing + 2.0;
     let mut world = walled(w, h, DVec2::new(0.0, -9.81), BroadPhaseMode::Auto);
+    world.set_method(method).expect("a method");
     let mut rng = Rng::new(3);
     for i in 0..N {
         let pos = DVec2::new(
@@ -131,6 +138,9 @@ fn stress(c: &mut Criterion) {
         ("radii_x100_grid", || radii_x100_with(BroadPhaseMode::Grid)),
         ("pile_9_layers", || pile(1000.0)),
         ("pile_90_layers", || pile(100.0)),
+        ("pile_9_layers_solve_8", || {
+            pile_under(1000.0, Method::Solve(8))
+        }),
     ] {
         let mut world = build();
         group.bench_with_input(BenchmarkId::new(name, N), &N, |b, _| {

@@ -88,6 +88,13 @@ pub trait KindHooks<V: Vector> {
         Ok(ctx.collide_default())
     }
 
+    /// Whether [`KindHooks::collide`] is the kind's own. Only pairs whose caller keeps the
+    /// default response can have their contacts solved together (`solve:n`); the others have
+    /// their hook called. True unless a kind says otherwise, so an override is never skipped.
+    fn has_collide(&self) -> bool {
+        true
+    }
+
     /// Whether [`KindHooks::update`] does anything; kinds without one cost nothing per step.
     fn has_update(&self) -> bool {
         false
@@ -110,7 +117,11 @@ pub trait KindHooks<V: Vector> {
 }
 
 /// The native behaviour: plain balls and walls.
-impl<V: Vector> KindHooks<V> for () {}
+impl<V: Vector> KindHooks<V> for () {
+    fn has_collide(&self) -> bool {
+        false
+    }
+}
 
 /// Default attributes of a kind's critters.
 #[derive(Clone, Debug, PartialEq)]
@@ -163,6 +174,7 @@ pub struct Kind<V: Vector> {
     pub hooks: Rc<dyn KindHooks<V>>,
     pub(crate) has_update: bool,
     pub(crate) has_init: bool,
+    pub(crate) has_collide: bool,
     pub(crate) rule_depends_on_state: bool,
 }
 
@@ -214,6 +226,7 @@ impl<V: Vector> KindSet<V> {
             parent,
             has_update: hooks.has_update(),
             has_init: hooks.has_init(),
+            has_collide: hooks.has_collide(),
             rule_depends_on_state: hooks.rule_depends_on_state(),
             defaults,
             hooks,

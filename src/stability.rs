@@ -596,11 +596,12 @@ fn glancing_3d(method: Method) -> Result<f64, Error> {
 }
 
 /// The methods the suite compares.
-pub const METHODS: [Method; 5] = [
+pub const METHODS: [Method; 6] = [
     Method::Discrete,
     Method::Substep(8),
     Method::Swept,
     Method::Event,
+    Method::Solve(8),
     Method::Auto,
 ];
 

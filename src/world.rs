@@ -249,6 +249,7 @@ pub struct World<V: Vector> {
     /// What `auto` chose for the last step, and why.
     pub(crate) auto_choice: Option<(Method, String)>,
     pub(crate) flight: crate::method::flight::Scratch<V>,
+    pub(crate) solve: crate::method::solve::Scratch<V>,
 }
 
 impl<V: Vector> World<V> {
@@ -283,6 +284,7 @@ impl<V: Vector> World<V> {
             method: config.method,
             auto_choice: None,
             flight: Default::default(),
+            solve: Default::default(),
         })
     }
 
@@ -314,6 +316,18 @@ impl<V: Vector> World<V> {
     }
     /// Changes the collision method (takes effect at the next step).
     pub fn set_method(&mut self, m: Method) -> Result<(), Error> {
+        if let Method::Solve(n) = m {
+            if !(1..=crate::method::MAX_SWEEPS).contains(&n) {
+                return Err(Error::InvalidWorld {
+                    field: "method",
+                    value: m.to_string(),
+                    reason: format!(
+                        "the sweep count must be from 1 to {}",
+                        crate::method::MAX_SWEEPS
+                    ),
+                });
+            }
+        }
         if let Method::Substep(n) = m {
             if !(1..=crate::method::MAX_SUBSTEPS).contains(&n) {
                 return Err(Error::InvalidWorld {
@@ -400,6 +414,41 @@ impl<V: Vector> World<V> {
         self.events.clear();
         self.auto_choice = None;
         self.flight = Default::default();
+        self.solve = Default::default();
+        Ok(())
+    }
+
+    /// Under `solve:n`, the last step's contact impulses that the next step starts from, as
+    /// (lower id, higher id, impulse) in ascending slots; nothing under the other methods.
+    pub fn contact_impulses(&self) -> impl Iterator<Item = (CritterId, CritterId, f64)> + '_ {
+        self.solve.warm.iter().filter_map(|&(key, j)| {
+            let (lo, hi) = ((key >> 32) as u32, key as u32);
+            let (a, b) = (self.critters.slot(lo)?, self.critters.slot(hi)?);
+            Some((a.id, b.id, j))
+        })
+    }
+
+    /// Restores the impulses [`World::contact_impulses`] gave, after [`World::restore`]. Refuses
+    /// pairs of critters this world does not have, or out of order.
+    pub(crate) fn set_contact_impulses(
+        &mut self,
+        impulses: impl Iterator<Item = (CritterId, CritterId, f64)>,
+    ) -> Result<(), String> {
+        let mut warm = Vec::new();
+        for (a, b, j) in impulses {
+            let known = |id: CritterId| self.critters.get(id).is_some();
+            if !(known(a) && known(b)) || a.index >= b.index || !(j.is_finite() && j > 0.0) {
+                return Err(format!(
+                    "the state's contact impulse ({a}, {b}, {j}) is not between two of its critters in order"
+                ));
+            }
+            let key = crate::method::solve::pair_key(a.index, b.index);
+            if warm.last().is_some_and(|&(k, _)| k >= key) {
+                return Err("the state's contact impulses are out of order".into());
+            }
+            warm.push((key, j));
+        }
+        self.solve.warm = warm;
         Ok(())
     }
 
@@ -760,6 +809,9 @@ impl<V: Vector> World<V> {
             }
             m => m,
         };
+        if !matches!(method, Method::Solve(_)) {
+            self.solve.warm.clear(); // kept only from one solve step to the next
+        }
         match method {
             Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
             Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
@@ -768,6 +820,12 @@ impl<V: Vector> World<V> {
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
+            Method::Solve(n) => {
+                let clock = Instant::now();
+                self.stage_move(self.dt);
+                stats.moving += clock.elapsed();
+                self.collide_stages(Some(n), &mut stats)?;
+            }
         }
         let clock = Instant::now();
         self.stage_lifecycle()?;
@@ -800,6 +858,12 @@ impl<V: Vector> World<V> {
 
     /// Broad phase, rules, narrow phase and response where the critters are now.
     pub(crate) fn discrete_collide(&mut self, stats: &mut StepStats) -> Result<(), Error> {
+        self.collide_stages(None, stats)
+    }
+
+    /// Broad phase, rules, narrow phase and response where the critters are now: Pop's response
+    /// pair by pair, or with `Some(n)` the contacts solved together in `n` sweeps.
+    fn collide_stages(&mut self, sweeps: Option<u32>, stats: &mut StepStats) -> Result<(), Error> {
         let mut clock = Instant::now();
         let mut lap = |slot: &mut Duration| {
             let now = Instant::now();
@@ -819,7 +883,10 @@ impl<V: Vector> World<V> {
         };
         self.sort_contacts();
         lap(&mut stats.narrow_phase);
-        let collisions = self.stage_response()?;
+        let collisions = match sweeps {
+            Some(n) => self.stage_solve(n)?,
+            None => self.stage_response()?,
+        };
         lap(&mut stats.response);
         stats.pair_tests += self.broad.tests;
         stats.candidates += self.candidates.len();

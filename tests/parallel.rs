@@ -53,3 +53,23 @@ fn a_large_3d_gas_is_bit_identical_on_one_and_two_threads() {
     };
     assert_eq!(run_in_pool(1, run), run_in_pool(2, run));
 }
+
+#[test]
+fn a_large_2d_gas_under_solve_is_bit_identical_on_one_and_two_threads() {
+    let run = || {
+        let params = GasParams {
+            n: PARALLEL_MIN + 1_000,
+            packing: 0.45,
+            ..GasParams::default()
+        };
+        let mut world = gas::<DVec2>(&params).expect("gas builds");
+        world
+            .set_method(critterbox::Method::Solve(4))
+            .expect("a method");
+        world.run(20).expect("steps");
+        (world.state_hash(), world.totals().contacts)
+    };
+    let (one, two) = (run_in_pool(1, run), run_in_pool(2, run));
+    assert_eq!(one, two);
+    assert!(one.1 > 0, "the gas collides");
+}

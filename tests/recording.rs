@@ -839,3 +839,52 @@ fn a_kind_loaded_mid_run_survives_a_killed_run() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("verify       ok"), "{}", text(&o));
 }
+
+/// Under `solve:n` each step starts from the last step's contact impulses: the full states carry
+/// them, so a step replayed from the keyframe before it is still the recorded one, and the
+/// whole file verifies.
+#[test]
+fn a_solve_run_is_replayed_from_its_keyframes_with_its_contact_impulses() {
+    let dir = tmp("restore_solve");
+    let (all, sparse) = (dir.join("every1.mcap"), dir.join("every25.mcap"));
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/pile.rhai");
+    let args = [
+        scene.to_str().unwrap(),
+        "--method",
+        "solve:8",
+        "--steps",
+        "240",
+    ];
+    record(&all, &[&args[..], &["--record-every", "1"]].concat());
+    record(&sparse, &[&args[..], &["--record-every", "25"]].concat());
+    let r = Recording::open(&sparse).expect("open");
+    let mut carried = 0;
+    for_each_state(&sparse, |s| {
+        carried += s.contact_impulses.len();
+        Ok(Flow::Continue)
+    })
+    .expect("states");
+    assert!(
+        carried > 0,
+        "test setup: the keyframes carry contact impulses"
+    );
+    for step in [60, 130, 239] {
+        let (shown, source) = state_at_step(&r, step).expect("a step");
+        let key = r.keyframe_at_or_before(step).expect("a keyframe");
+        assert_eq!(
+            source,
+            StateSource::Restored { keyframe: key },
+            "step {step}"
+        );
+        let truth = state_at(&all, step)
+            .expect("read")
+            .expect("every step recorded");
+        assert_eq!(
+            first_difference(&truth, &shown, "recorded", "replayed"),
+            None,
+            "step {step}"
+        );
+    }
+    let report = verify(&r, |_| {}).expect("verifies");
+    assert!(report.passed(), "{report:?}");
+}

@@ -51,7 +51,7 @@ pub struct RunArgs {
     /// Number of critters, for scenes that have a natural count (gas, cradle, pegs).
     #[arg(short = 'n', long)]
     pub n: Option<usize>,
-    /// Collision method: discrete, substep:N, swept, event or auto (default: the scene's own).
+    /// Collision method: discrete, substep:N, swept, event, solve:N or auto (default: the scene's own).
     #[arg(long, value_parser = parse_method)]
     pub method: Option<crate::method::Method>,
     /// Also print time per stage and pair counts per step.

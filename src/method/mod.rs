@@ -6,6 +6,9 @@
 //!   impact resolved in time order, then a discrete pass for resting contacts. No tunnelling.
 //! * [`Method::Event`]: exact event-driven dynamics ([`event`]): parabolic flights under gravity,
 //!   collisions, wall hits, border and cell crossings processed in time order.
+//! * [`Method::Solve`]: the discrete step with its contacts solved together ([`solve`]): `n`
+//!   sweeps of sequential impulses over every contact, then a partial position correction, so
+//!   piles and stacks come to rest.
 //! * [`Method::Auto`]: discrete or swept per step from the scene's speeds, and within a swept
 //!   step predictions only for the critters that are fast or may meet something ([`auto`]).
 //!
@@ -17,6 +20,7 @@ pub mod auto;
 pub mod event;
 pub(crate) mod flight;
 mod queue;
+pub mod solve;
 pub mod swept;
 pub mod toi;
 
@@ -35,6 +39,8 @@ pub enum Method {
     Swept,
     /// Exact event-driven dynamics.
     Event,
+    /// Discrete with the contacts solved together by `n` sweeps of sequential impulses (n >= 1).
+    Solve(u32),
     /// The cheapest method that keeps the tolerances, chosen each step and per critter.
     Auto,
 }
@@ -46,10 +52,14 @@ impl fmt::Display for Method {
             Method::Substep(n) => write!(f, "substep:{n}"),
             Method::Swept => write!(f, "swept"),
             Method::Event => write!(f, "event"),
+            Method::Solve(n) => write!(f, "solve:{n}"),
             Method::Auto => write!(f, "auto"),
         }
     }
 }
+
+/// Largest sweep count of `solve` accepted.
+pub const MAX_SWEEPS: u32 = 10_000;
 
 /// Largest substep count accepted (a guard against typos like `substep:1000000000`).
 pub const MAX_SUBSTEPS: u32 = 100_000;
@@ -58,9 +68,21 @@ impl FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let s = s.trim();
-        let usage = "use discrete, substep:N, swept, event or auto";
+        let usage = "use discrete, substep:N, swept, event, solve:N or auto";
+        if let Some(n) = s
+            .strip_prefix("solve:")
+            .or_else(|| s.strip_prefix("solve(").and_then(|r| r.strip_suffix(')')))
+        {
+            return match n.trim().parse::<u32>() {
+                Ok(n) if (1..=MAX_SWEEPS).contains(&n) => Ok(Method::Solve(n)),
+                _ => Err(format!(
+                    "method '{s}': the sweep count must be a whole number from 1 to {MAX_SWEEPS}"
+                )),
+            };
+        }
         match s {
             "discrete" => Ok(Method::Discrete),
+            "solve" => Ok(Method::Solve(solve::DEFAULT_SWEEPS)),
             "swept" => Ok(Method::Swept),
             "event" => Ok(Method::Event),
             "auto" => Ok(Method::Auto),
@@ -91,11 +113,18 @@ mod tests {
             Method::Substep(4),
             Method::Swept,
             Method::Event,
+            Method::Solve(8),
             Method::Auto,
         ] {
             assert_eq!(m.to_string().parse::<Method>(), Ok(m));
         }
         assert_eq!("substep(3)".parse::<Method>(), Ok(Method::Substep(3)));
+        assert_eq!("solve(3)".parse::<Method>(), Ok(Method::Solve(3)));
+        assert_eq!(
+            "solve".parse::<Method>(),
+            Ok(Method::Solve(solve::DEFAULT_SWEEPS))
+        );
+        assert!("solve:0".parse::<Method>().is_err());
         assert!("substep:0".parse::<Method>().is_err());
         assert!("substep:x".parse::<Method>().is_err());
         assert!("fast".parse::<Method>().is_err());

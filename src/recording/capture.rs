@@ -101,6 +101,10 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
         walls: Vec::new(),
         rng: Some(world.rng_state().to_vec()),
         free: Some(world.critters().free_ids().map(id_key).collect()),
+        contact_impulses: world
+            .contact_impulses()
+            .map(|(a, b, j)| (id_key(a), id_key(b), Float(j)))
+            .collect(),
     };
     for c in world.critters().iter() {
         let id = id_key(c.id());

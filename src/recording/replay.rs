@@ -210,7 +210,12 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
                 .unwrap_or_default(),
         });
     }
-    w.restore(s.step, rng, critters, &free)
+    w.restore(s.step, rng, critters, &free)?;
+    let impulses = s
+        .contact_impulses
+        .iter()
+        .map(|&(a, b, j)| (id_of(a), id_of(b), j.0));
+    w.set_contact_impulses(impulses)
 }
 
 /// The exact state after `step` steps: from the file if it holds that state, else re-simulated

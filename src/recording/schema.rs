@@ -244,6 +244,11 @@ pub struct StateMsg {
     /// the next critters in them will get.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub free: Option<Vec<u64>>,
+    /// Under `solve:n`, the impulses of the step's contacts, which the next step starts from
+    /// (its warm start), as (lower id, higher id, impulse), ascending: a replay from this state
+    /// needs them to be exact. Empty under the other methods.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact_impulses: Vec<(u64, u64, Float)>,
 }
 
 impl StateMsg {

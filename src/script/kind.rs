@@ -441,6 +441,10 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
         })
     }
 
+    fn has_collide(&self) -> bool {
+        self.def.hook("collide").is_some()
+    }
+
     fn has_update(&self) -> bool {
         self.def.hook("update").is_some()
     }

@@ -1,0 +1,432 @@
+//! `solve:n`: the discrete step with its contacts solved together, so that piles and stacks come
+//! to rest.
+//!
+//! Pop's response takes one touching pair at a time and removes its whole overlap at once. In a
+//! pile each such push moves a ball into its next neighbour, and under gravity the pile never
+//! settles (`docs/stability.md`, the deep pile). Here the step moves and finds its contacts as
+//! the discrete step does, then treats every touching pair whose caller keeps the default
+//! response as one constraint of a system solved by sequential impulses (projected Gauss-Seidel):
+//!
+//! 1. each contact's wanted relative normal velocity is `-e v0` for the approach speed `v0` it
+//!    has when the solve starts, or 0 when `v0` is below [`RESTING_STEPS`] steps of gravity (a
+//!    resting contact does not bounce on its own weight);
+//! 2. each contact starts from the impulse the same pair ended the last step with (the warm
+//!    start: a deep pile's weight is carried over from step to step instead of being found
+//!    again by the sweeps every step);
+//! 3. `n` sweeps over the contacts, alternately forwards and backwards, each correct one
+//!    contact's normal velocity towards its wanted value with an impulse, keeping the contact's
+//!    accumulated impulse non-negative (contacts push, never pull);
+//! 4. the critters are moved on by the solve's change of velocity times dt: the move advanced
+//!    them by their velocities before it, and semi-implicit Euler advances them by the solved
+//!    ones (a ball resting on the floor does not sink by g dt^2 every step);
+//! 5. up to [`POSITION_SWEEPS`] sweeps move the pairs apart by [`POSITION_SHARE`] of their
+//!    overlap beyond a slop of [`SLOP`] radii, split by inverse mass, without changing any
+//!    velocity.
+//!
+//! An isolated pair gets exactly Pop's impulse `-(1 + e) v0 / (1/m1 + 1/m2)` in the first sweep,
+//! and every impulse and position move is equal and opposite (by mass), so momentum is kept to
+//! rounding and the centre of mass moves on undisturbed. Pairs whose caller has its own
+//! `collide` hook are handed to it first, in the discrete step's order; the solve then takes the
+//! remaining contacts where the hooks left the critters.
+//!
+//! The impulses carried to the next step are the only state the solve keeps
+//! ([`World::contact_impulses`]); recordings write them with every full state, so a run replays
+//! exactly from any recorded state.
+
+use crate::context::CollisionEvent;
+use crate::error::Error;
+use crate::vector::Vector;
+use crate::world::{at_step, roles_order, World};
+
+/// Sweeps of `solve` when the method is named without a count.
+pub const DEFAULT_SWEEPS: u32 = 8;
+
+/// Restitution applies to contacts approaching faster than this many steps of gravity (`|g| dt`);
+/// slower ones are resting and end at zero normal speed. 0 without gravity.
+pub const RESTING_STEPS: f64 = 2.0;
+
+/// Overlap left alone, in radii of the smaller critter of a pair (walls: the disk's).
+pub const SLOP: f64 = 0.01;
+
+/// Share of the overlap beyond the slop removed by each position sweep.
+pub const POSITION_SHARE: f64 = 0.2;
+
+/// Largest move of one pair in one position sweep, in radii of the smaller critter.
+pub const LARGEST_CORRECTION: f64 = 0.2;
+
+/// Position sweeps per step (fewer once every overlap is within three slops).
+pub const POSITION_SWEEPS: u32 = 3;
+
+/// The sweeps take the contacts this many apart (see [`World::stage_solve`]).
+const INTERLEAVE: usize = 16;
+
+/// One contact of the solve.
+#[derive(Clone, Copy, Debug)]
+struct Row<V> {
+    /// Caller's and arg's slots.
+    a: u32,
+    b: u32,
+    /// Unit normal from caller to arg.
+    n: V,
+    /// 1 / (1/m_a + 1/m_b).
+    k: f64,
+    /// Wanted relative normal velocity.
+    target: f64,
+    /// Accumulated impulse on the arg along `n`.
+    impulse: f64,
+    /// Overlap found by the narrow phase (the position sweeps hold the normal and follow the
+    /// overlap to first order in the pair's moves).
+    depth: f64,
+    /// Smaller radius of the pair.
+    scale: f64,
+    /// The row's collision event, counted from the solve's first.
+    event: u32,
+}
+
+/// The solve's working arrays, kept between steps only to save allocations.
+#[derive(Debug)]
+pub(crate) struct Scratch<V> {
+    rows: Vec<Row<V>>,
+    spare: Vec<Row<V>>,
+    /// Velocity, position shift, position and inverse mass by slot.
+    vel: Vec<V>,
+    shift: Vec<V>,
+    pos: Vec<V>,
+    inv_mass: Vec<f64>,
+    plain: Vec<(u32, u32)>,
+    /// The rows' pair keys, in the order the rows were built.
+    keys: Vec<u64>,
+    /// The last step's accumulated impulses by pair key, ascending: the only state the solve
+    /// carries from one step to the next (recorded with every full state).
+    pub(crate) warm: Vec<(u64, f64)>,
+}
+
+impl<V> Default for Scratch<V> {
+    fn default() -> Self {
+        Scratch {
+            rows: Vec::new(),
+            spare: Vec::new(),
+            vel: Vec::new(),
+            shift: Vec::new(),
+            pos: Vec::new(),
+            inv_mass: Vec::new(),
+            plain: Vec::new(),
+            keys: Vec::new(),
+            warm: Vec::new(),
+        }
+    }
+}
+
+impl<V: Vector> World<V> {
+    /// The response stage of `solve:n`: hooks first, then the rest solved together. Returns how
+    /// many pairs were handled.
+    pub(crate) fn stage_solve(&mut self, sweeps: u32) -> Result<usize, Error> {
+        let mut scratch = std::mem::take(&mut self.solve);
+        let result = self.solve_with(&mut scratch, sweeps);
+        self.solve = scratch;
+        result
+    }
+
+    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: u32) -> Result<usize, Error> {
+        let mut handled = 0;
+        // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
+        s.plain.clear();
+        let contacts = std::mem::take(&mut self.contacts);
+        let mut result = Ok(());
+        for &(caller, arg) in &contacts {
+            if self.own_collide(caller) {
+                match self.collide_pair(caller, arg) {
+                    Ok(true) => handled += 1,
+                    Ok(false) => {}
+                    Err(e) => {
+                        result = Err(e);
+                        break;
+                    }
+                }
+            } else {
+                s.plain.push((caller, arg));
+            }
+        }
+        self.contacts = contacts;
+        result?;
+        let wall_pairs = std::mem::take(&mut self.wall_pairs);
+        let mut result = Ok(());
+        for &(first, second, ask) in &wall_pairs {
+            let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
+                continue;
+            };
+            if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none()
+            {
+                continue;
+            }
+            let (caller, arg) = if ask {
+                match crate::rules::roles_of(&self.kinds, &self.topo, a, b) {
+                    Ok(rule) => match roles_order(rule, a, b) {
+                        Some((c, x)) => (c.id.index, x.id.index),
+                        None => continue,
+                    },
+                    Err(e) => {
+                        result = Err(at_step(e, self.step_count));
+                        break;
+                    }
+                }
+            } else {
+                (first, second)
+            };
+            self.contacts.push((caller, arg));
+            if self.own_collide(caller) {
+                match self.collide_pair(caller, arg) {
+                    Ok(true) => handled += 1,
+                    Ok(false) => {}
+                    Err(e) => {
+                        result = Err(e);
+                        break;
+                    }
+                }
+            } else {
+                s.plain.push((caller, arg));
+            }
+        }
+        self.wall_pairs = wall_pairs;
+        result?;
+
+        // 2. The rows, where the hooks left the critters.
+        s.vel.clear();
+        s.pos.clear();
+        s.inv_mass.clear();
+        for slot in self.critters.slot_slice() {
+            match slot {
+                Some(c) if c.alive => {
+                    s.vel.push(c.vel);
+                    s.pos.push(c.pos);
+                    s.inv_mass.push(c.inv_mass());
+                }
+                _ => {
+                    s.vel.push(V::zero());
+                    s.pos.push(V::zero());
+                    s.inv_mass.push(0.0);
+                }
+            }
+        }
+        s.shift.clear();
+        s.shift.extend_from_slice(&s.vel);
+        let resting = RESTING_STEPS * self.gravity.length() * self.dt;
+        s.rows.clear();
+        s.keys.clear();
+        let first_event = self.events.collisions.len();
+        let mut warm = Warm::new(&s.warm);
+        for &(a, b) in &s.plain {
+            let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
+                continue;
+            };
+            if !ca.alive || !cb.alive {
+                continue;
+            }
+            let Some(c) = crate::response::contact_between(&self.topo, ca, cb) else {
+                continue;
+            };
+            let (ia, ib) = (s.inv_mass[a as usize], s.inv_mass[b as usize]);
+            if ia + ib == 0.0 {
+                continue; // two fixed critters: nothing can move
+            }
+            let v0 = (s.vel[b as usize] - s.vel[a as usize]).dot(c.normal);
+            let e = ca.restitution.min(cb.restitution);
+            let scale = match (ca.is_wall(), cb.is_wall()) {
+                (true, _) => cb.radius,
+                (_, true) => ca.radius,
+                _ => ca.radius.min(cb.radius),
+            };
+            // The last step's impulse of the pair is given again before the sweeps (warm start),
+            // once every row's approach speed is known.
+            let key = pair_key(a, b);
+            let start = warm.impulse(key);
+            s.keys.push(key);
+            s.rows.push(Row {
+                a,
+                b,
+                n: c.normal,
+                k: 1.0 / (ia + ib),
+                target: if v0 < -resting { -e * v0 } else { 0.0 },
+                impulse: start,
+                depth: c.depth,
+                scale,
+                event: s.rows.len() as u32,
+            });
+            self.events.collisions.push(CollisionEvent {
+                caller: ca.id,
+                arg: cb.id,
+                point: ca.pos + c.point,
+                normal: c.normal,
+                impulse: 0.0,
+            });
+        }
+
+        for row in &s.rows {
+            let (a, b) = (row.a as usize, row.b as usize);
+            s.vel[a] -= row.n * (row.impulse * s.inv_mass[a]);
+            s.vel[b] += row.n * (row.impulse * s.inv_mass[b]);
+        }
+
+        // Rows next to each other in the contact order mostly share a critter, and each would
+        // wait for the one before it to store its velocity: taken INTERLEAVE apart, the sweeps'
+        // neighbours are mostly independent and their work overlaps.
+        s.spare.clear();
+        for start in 0..INTERLEAVE.min(s.rows.len()) {
+            s.spare
+                .extend(s.rows.iter().skip(start).step_by(INTERLEAVE));
+        }
+        std::mem::swap(&mut s.rows, &mut s.spare);
+
+        // 3. Velocities: sweeps of sequential impulses, alternately forwards and backwards.
+        for sweep in 0..sweeps {
+            if sweep % 2 == 0 {
+                for row in s.rows.iter_mut() {
+                    push_velocities(row, &mut s.vel, &s.inv_mass);
+                }
+            } else {
+                for row in s.rows.iter_mut().rev() {
+                    push_velocities(row, &mut s.vel, &s.inv_mass);
+                }
+            }
+        }
+
+        // The move advanced each critter by its velocity before the solve; it should have gone
+        // by the solved one (x + v' dt, semi-implicit Euler with the impulses in v'): a ball
+        // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
+        // before the solve.
+        let dt = self.dt;
+        for (shift, &v) in s.shift.iter_mut().zip(&s.vel) {
+            *shift = (v - *shift) * dt;
+        }
+
+        // 4. Positions: part of each overlap removed, velocities untouched.
+        for _ in 0..POSITION_SWEEPS {
+            let mut deepest = f64::NEG_INFINITY;
+            for row in s.rows.iter_mut() {
+                let (a, b) = (row.a as usize, row.b as usize);
+                let n = row.n;
+                let depth = row.depth - (s.shift[b] - s.shift[a]).dot(n);
+                let slop = SLOP * row.scale;
+                deepest = deepest.max(depth - 3.0 * slop);
+                let fix = (POSITION_SHARE * (depth - slop)).min(LARGEST_CORRECTION * row.scale);
+                if fix > 0.0 {
+                    let push = fix * row.k;
+                    s.shift[a] -= n * (push * s.inv_mass[a]);
+                    s.shift[b] += n * (push * s.inv_mass[b]);
+                }
+            }
+            if deepest <= 0.0 {
+                break;
+            }
+        }
+
+        // 5. Back to the critters; the events get their impulses.
+        for row in &s.rows {
+            if let Some(event) = self
+                .events
+                .collisions
+                .get_mut(first_event + row.event as usize)
+            {
+                event.impulse = row.impulse;
+            }
+        }
+        // The impulses kept for the next step's warm start, in key order: the rows were built
+        // from two runs in key order (disk pairs, then wall pairs), merged here.
+        let impulses: Vec<f64> = self.events.collisions[first_event..]
+            .iter()
+            .map(|e| e.impulse)
+            .collect();
+        s.warm.clear();
+        let split = s
+            .keys
+            .windows(2)
+            .position(|w| w[1] < w[0])
+            .map_or(s.keys.len(), |i| i + 1);
+        let (mut i, mut j) = (0, split);
+        while i < split || j < s.keys.len() {
+            let take_first = j == s.keys.len() || (i < split && s.keys[i] < s.keys[j]);
+            let k = if take_first { &mut i } else { &mut j };
+            if impulses[*k] > 0.0 {
+                s.warm.push((s.keys[*k], impulses[*k]));
+            }
+            *k += 1;
+        }
+        if !s.rows.is_empty() {
+            let slots = self.critters.slots_mut_moving().iter_mut().enumerate();
+            for (i, c) in slots.filter_map(|(i, c)| Some((i, c.as_mut()?))) {
+                if s.inv_mass[i] > 0.0 {
+                    c.vel = s.vel[i];
+                    c.pos = s.pos[i] + s.shift[i];
+                }
+            }
+        }
+        if self.topo.wraps() {
+            // The hooks or the position sweeps may have pushed a critter across the edge.
+            let topo = self.topo;
+            for c in self
+                .critters
+                .iter_mut_moving()
+                .filter(|c| c.alive && !c.is_wall())
+            {
+                c.pos = topo.wrap_position(c.pos);
+            }
+        }
+        Ok(handled + s.rows.len())
+    }
+
+    /// True when `slot`'s kind has its own `collide` hook.
+    fn own_collide(&self, slot: u32) -> bool {
+        self.critters
+            .slot(slot)
+            .is_some_and(|c| self.kinds.get(c.kind).has_collide)
+    }
+}
+
+/// The key of a pair of slots, whichever is the caller: lower slot, then higher.
+pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
+    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+}
+
+/// Looks up the last step's impulses for keys that come in ascending runs.
+struct Warm<'a> {
+    list: &'a [(u64, f64)],
+    at: usize,
+    last: u64,
+}
+
+impl<'a> Warm<'a> {
+    fn new(list: &'a [(u64, f64)]) -> Self {
+        Warm {
+            list,
+            at: 0,
+            last: 0,
+        }
+    }
+
+    /// The impulse kept for `key`, or 0.
+    fn impulse(&mut self, key: u64) -> f64 {
+        if key < self.last {
+            self.at = 0; // a new run
+        }
+        self.last = key;
+        while self.list.get(self.at).is_some_and(|&(k, _)| k < key) {
+            self.at += 1;
+        }
+        match self.list.get(self.at) {
+            Some(&(k, j)) if k == key => j,
+            _ => 0.0,
+        }
+    }
+}
+
+/// One contact's impulse of a velocity sweep.
+#[inline]
+fn push_velocities<V: Vector>(row: &mut Row<V>, vel: &mut [V], inv_mass: &[f64]) {
+    let (a, b) = (row.a as usize, row.b as usize);
+    let vn = (vel[b] - vel[a]).dot(row.n);
+    let total = (row.impulse - (vn - row.target) * row.k).max(0.0);
+    let j = total - row.impulse;
+    row.impulse = total;
+    vel[a] -= row.n * (j * inv_mass[a]);
+    vel[b] += row.n * (j * inv_mass[b]);
+}
