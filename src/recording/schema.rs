@@ -533,6 +533,12 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
             "rng": { "type": "array", "items": { "type": "integer", "minimum": 0 },
                      "description": "the random generator's four 64-bit words after the step" },
             "free": ids_schema("free slots in the world's order (the last is reused first), as the ids their next critters get"),
+            "contact_impulses": { "type": "array", "items": {
+                "type": "array",
+                "prefixItems": [ { "type": "integer", "minimum": 0 },
+                                 { "type": "integer", "minimum": 0 }, float_schema() ],
+                "minItems": 3, "maxItems": 3,
+            }, "description": "solve:n only: the impulses the step's contacts ended with, which the next step starts from, as [lower id, higher id, impulse] in ascending slots" },
         })),
         &[
             "step",
