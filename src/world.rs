@@ -1216,26 +1216,13 @@ impl<V: Vector> World<V> {
         let wall_pairs = std::mem::take(&mut self.wall_pairs);
         let mut result = Ok(());
         for &(first, second, ask) in &wall_pairs {
-            let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
-                continue;
-            };
-            if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none()
-            {
-                continue;
-            }
-            let (caller, arg) = if ask {
-                match crate::rules::roles_of(&self.kinds, &self.topo, a, b) {
-                    Ok(rule) => match roles_order(rule, a, b) {
-                        Some((c, x)) => (c.id.index, x.id.index),
-                        None => continue,
-                    },
-                    Err(e) => {
-                        result = Err(at_step(e, self.step_count));
-                        break;
-                    }
+            let (caller, arg) = match self.touching_wall_pair(first, second, ask) {
+                Ok(Some(pair)) => pair,
+                Ok(None) => continue,
+                Err(e) => {
+                    result = Err(e);
+                    break;
                 }
-            } else {
-                (first, second)
             };
             self.contacts.push((caller, arg));
             match self.collide_pair(caller, arg) {
@@ -1261,6 +1248,28 @@ impl<V: Vector> World<V> {
             }
         }
         Ok(collisions)
+    }
+
+    /// A candidate pair with a wall, tested where the critters are now: (caller, arg) when both
+    /// are alive, touch, and their rule lets them collide (asked of the hooks when `ask`).
+    pub(crate) fn touching_wall_pair(
+        &self,
+        first: u32,
+        second: u32,
+        ask: bool,
+    ) -> Result<Option<(u32, u32)>, Error> {
+        let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
+            return Ok(None);
+        };
+        if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none() {
+            return Ok(None);
+        }
+        if !ask {
+            return Ok(Some((first, second)));
+        }
+        let rule = crate::rules::roles_of(&self.kinds, &self.topo, a, b)
+            .map_err(|e| at_step(e, self.step_count))?;
+        Ok(roles_order(rule, a, b).map(|(c, x)| (c.id.index, x.id.index)))
     }
 
     /// Calls the caller's `collide` on a touching pair, if both are still alive.

@@ -36,7 +36,7 @@
 use crate::context::CollisionEvent;
 use crate::error::Error;
 use crate::vector::Vector;
-use crate::world::{at_step, roles_order, World};
+use crate::world::World;
 
 /// Sweeps of `solve` when the method is named without a count.
 pub const DEFAULT_SWEEPS: u32 = 8;
@@ -131,62 +131,21 @@ impl<V: Vector> World<V> {
         let mut handled = 0;
         // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
         s.plain.clear();
+        let plain = &mut s.plain;
         let contacts = std::mem::take(&mut self.contacts);
-        let mut result = Ok(());
-        for &(caller, arg) in &contacts {
-            if self.own_collide(caller) {
-                match self.collide_pair(caller, arg) {
-                    Ok(true) => handled += 1,
-                    Ok(false) => {}
-                    Err(e) => {
-                        result = Err(e);
-                        break;
-                    }
-                }
-            } else {
-                s.plain.push((caller, arg));
-            }
-        }
+        let result = contacts
+            .iter()
+            .try_for_each(|&(caller, arg)| self.hook_or_keep(caller, arg, plain, &mut handled));
         self.contacts = contacts;
         result?;
         let wall_pairs = std::mem::take(&mut self.wall_pairs);
-        let mut result = Ok(());
-        for &(first, second, ask) in &wall_pairs {
-            let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
-                continue;
-            };
-            if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none()
-            {
-                continue;
-            }
-            let (caller, arg) = if ask {
-                match crate::rules::roles_of(&self.kinds, &self.topo, a, b) {
-                    Ok(rule) => match roles_order(rule, a, b) {
-                        Some((c, x)) => (c.id.index, x.id.index),
-                        None => continue,
-                    },
-                    Err(e) => {
-                        result = Err(at_step(e, self.step_count));
-                        break;
-                    }
-                }
-            } else {
-                (first, second)
+        let result = wall_pairs.iter().try_for_each(|&(first, second, ask)| {
+            let Some((caller, arg)) = self.touching_wall_pair(first, second, ask)? else {
+                return Ok(());
             };
             self.contacts.push((caller, arg));
-            if self.own_collide(caller) {
-                match self.collide_pair(caller, arg) {
-                    Ok(true) => handled += 1,
-                    Ok(false) => {}
-                    Err(e) => {
-                        result = Err(e);
-                        break;
-                    }
-                }
-            } else {
-                s.plain.push((caller, arg));
-            }
-        }
+            self.hook_or_keep(caller, arg, plain, &mut handled)
+        });
         self.wall_pairs = wall_pairs;
         result?;
 
@@ -372,6 +331,23 @@ impl<V: Vector> World<V> {
             }
         }
         Ok(handled + s.rows.len())
+    }
+
+    /// Calls `caller`'s own `collide` on the pair (counted in `handled` when it touched), or
+    /// keeps the pair for the solve when the caller's kind has none.
+    fn hook_or_keep(
+        &mut self,
+        caller: u32,
+        arg: u32,
+        plain: &mut Vec<(u32, u32)>,
+        handled: &mut usize,
+    ) -> Result<(), Error> {
+        if !self.own_collide(caller) {
+            plain.push((caller, arg));
+        } else if self.collide_pair(caller, arg)? {
+            *handled += 1;
+        }
+        Ok(())
     }
 
     /// True when `slot`'s kind has its own `collide` hook.
