@@ -1236,8 +1236,14 @@ impl<V: Vector> World<V> {
         }
         self.wall_pairs = wall_pairs;
         result?;
+        // Separation may have pushed a critter across the periodic edge.
+        self.wrap_positions();
+        Ok(collisions)
+    }
+
+    /// In a periodic world, maps every live critter back into the box.
+    pub(crate) fn wrap_positions(&mut self) {
         if self.topo.wraps() {
-            // Separation may have pushed a critter across the periodic edge.
             let topo = self.topo;
             for c in self
                 .critters
@@ -1247,7 +1253,6 @@ impl<V: Vector> World<V> {
                 c.pos = topo.wrap_position(c.pos);
             }
         }
-        Ok(collisions)
     }
 
     /// A candidate pair with a wall, tested where the critters are now: (caller, arg) when both

@@ -319,17 +319,8 @@ impl<V: Vector> World<V> {
                 }
             }
         }
-        if self.topo.wraps() {
-            // The hooks or the position sweeps may have pushed a critter across the edge.
-            let topo = self.topo;
-            for c in self
-                .critters
-                .iter_mut_moving()
-                .filter(|c| c.alive && !c.is_wall())
-            {
-                c.pos = topo.wrap_position(c.pos);
-            }
-        }
+        // The hooks or the position sweeps may have pushed a critter across the edge.
+        self.wrap_positions();
         Ok(handled + s.rows.len())
     }
 
