@@ -690,6 +690,11 @@ struct PairList<V: Vector> {
     fast: f64,
     bounds: Vec<Bound<V>>,
     pairs: Vec<(u32, u32)>,
+    /// True once `pairs` are in the order of their lower index, then their higher one
+    /// (repairs then keep it); a build leaves them in the grid's order.
+    sorted: bool,
+    /// Set by [`BroadPhase::sort_list`]: sort `pairs` when the list is next kept.
+    sort_wanted: bool,
     rebuilds: u64,
     /// Indices whose box was made anew by a repair since the build (one bit each): their
     /// entries in the build's levels are stale.
@@ -707,6 +712,8 @@ impl<V: Vector> Default for PairList<V> {
             fast: 0.0,
             bounds: Vec::new(),
             pairs: Vec::new(),
+            sorted: false,
+            sort_wanted: false,
             rebuilds: 0,
             moved: Vec::new(),
             extras: Vec::new(),
@@ -807,6 +814,28 @@ fn retest<V: Vector, O: Objects<V> + ?Sized>(
         }
         out.extend(exact(objs, topo, pair));
     }
+}
+
+/// Sorts the pairs from `start` on by their lower index, then their higher one, and merges them
+/// into the pairs before, which are in that order already.
+fn merge_tail(pairs: &mut Vec<(u32, u32)>, start: usize) {
+    let key = |&(a, b): &(u32, u32)| (a.min(b), a.max(b));
+    pairs[start..].sort_unstable_by_key(key);
+    let mut tail = pairs.split_off(start);
+    let (mut i, mut j) = (start, tail.len());
+    pairs.resize(start + tail.len(), (0, 0));
+    // From the back: each place is written after the pair it held was read.
+    while j > 0 {
+        let k = i + j - 1;
+        if i > 0 && key(&pairs[i - 1]) > key(&tail[j - 1]) {
+            pairs[k] = pairs[i - 1];
+            i -= 1;
+        } else {
+            pairs[k] = tail[j - 1];
+            j -= 1;
+        }
+    }
+    tail.clear();
 }
 
 /// The tag bit of a wall's [`CellBox`] and [`Bound`].
@@ -955,6 +984,9 @@ impl<V: Vector> BroadPhase<V> {
         let valid = kept && held.unwrap_or_else(|| self.list_still_valid(objs, topo));
         if !(valid || kept && self.repair_list(objs, topo)) {
             self.rebuild_list(objs, topo);
+        } else if self.list.sort_wanted && !self.list.sorted {
+            crate::world::sort_pairs(&mut self.list.pairs, objs.slots());
+            self.list.sorted = true;
         }
         self.tests += self.list.pairs.len() as u64;
         if objs.slots() >= crate::world::PARALLEL_MIN {
@@ -1006,6 +1038,8 @@ impl<V: Vector> BroadPhase<V> {
         pairs.clear();
         self.grid_padded(&led, topo, &mut pairs, 0.5 * skin);
         self.list.pairs = pairs;
+        self.list.sorted = false;
+        self.list.sort_wanted = false;
         let bound = |i: usize| Bound::new(led.object(i).as_ref(), 0.5 * skin);
         self.list.bounds.clear();
         if objs.slots() >= crate::world::PARALLEL_MIN {
@@ -1085,6 +1119,7 @@ impl<V: Vector> BroadPhase<V> {
         list.extras.retain(|b| !bit(&leaving, b.index() as usize));
         list.pairs
             .retain(|&(a, b)| !bit(&leaving, a as usize) && !bit(&leaving, b as usize));
+        let kept = list.pairs.len();
         for (i, b) in fresh {
             list.bounds[i as usize] = Bound::new(led.object(i as usize).as_ref(), half_skin);
             let Some(b) = b else {
@@ -1104,8 +1139,30 @@ impl<V: Vector> BroadPhase<V> {
             }
             list.extras.push(b);
         }
+        if list.sorted {
+            merge_tail(&mut list.pairs, kept);
+        }
         list.repairs += 1;
         true
+    }
+
+    /// Asks for the Verlet list's pairs in the order of their lower index, then their higher
+    /// one: they are sorted when the list is next kept (not built anew), and stay so until its
+    /// next build. The world asks for it when many of the pairs are contacts (a pile): the pairs
+    /// found each step then come in the order the response takes them in, and need no sort of
+    /// their own. A gas, with few contacts, keeps the grid's order and sorts its few contacts
+    /// each step instead; a list built anew every step is never sorted.
+    pub(crate) fn sort_list(&mut self) {
+        self.list.sort_wanted = true;
+    }
+
+    /// Pairs in the Verlet list (0 without one).
+    pub(crate) fn listed(&self) -> usize {
+        if self.list.valid {
+            self.list.pairs.len()
+        } else {
+            0
+        }
     }
 
     /// How many times the Verlet list was rebuilt (diagnostics).
@@ -1823,9 +1880,21 @@ mod tests {
                 p
             };
             let steps = 60;
+            let mut kept_in_order = 0;
             for step in 0..steps {
                 let mut listed = Vec::new();
                 phase.find_pairs_in(&objs, &topo, &mut listed, None);
+                if phase.list.sorted {
+                    // A sorted list stays sorted through its repairs (by index: the world's
+                    // indices are its slots, so its pairs then come out in the response's order).
+                    let key = |&(a, b): &(u32, u32)| (a.min(b), a.max(b));
+                    assert!(phase.list.pairs.is_sorted_by_key(key), "step {step}");
+                    kept_in_order += 1;
+                }
+                // The second half of the steps asks for the list in order, as a pile's world does.
+                if step >= steps / 2 {
+                    phase.sort_list();
+                }
                 let count = listed.len();
                 let listed = normalise(listed);
                 let mut once = listed.clone();
@@ -1878,10 +1947,53 @@ mod tests {
                 }
             }
             assert!(
+                kept_in_order >= 10,
+                "{kept_in_order} steps from a sorted list"
+            );
+            assert!(
                 phase.repairs() >= steps as u64 / 2 && phase.rebuilds() <= 10,
                 "{border:?}: {} repairs and {} rebuilds in {steps} steps",
                 phase.repairs(),
                 phase.rebuilds()
+            );
+        }
+    }
+
+    #[test]
+    fn a_sorted_tail_merged_gives_the_whole_list_sorted() {
+        let mut rng = Rng::new(5);
+        let key = |&(a, b): &(u32, u32)| (a.min(b), a.max(b));
+        for (len, tail) in [
+            (0, 0),
+            (0, 5),
+            (7, 0),
+            (1, 1),
+            (200, 3),
+            (200, 150),
+            (3, 40),
+        ] {
+            let mut pairs: Vec<(u32, u32)> = (0..len + tail)
+                .map(|_| {
+                    let a = (rng.next_u64() % 1000) as u32;
+                    let b = a + 1 + (rng.next_u64() % 50) as u32;
+                    if rng.next_f64() < 0.5 {
+                        (b, a)
+                    } else {
+                        (a, b)
+                    }
+                })
+                .collect();
+            pairs[..len].sort_unstable_by_key(key);
+            let mut expected = pairs.clone();
+            expected.sort_by_key(key);
+            merge_tail(&mut pairs, len);
+            assert!(pairs.is_sorted_by_key(key), "{len} + {tail}");
+            let (mut got, mut want) = (pairs.clone(), expected);
+            got.sort_unstable();
+            want.sort_unstable();
+            assert_eq!(
+                got, want,
+                "{len} + {tail}: the same pairs, each the same way round"
             );
         }
     }

@@ -1086,7 +1086,13 @@ impl<V: Vector> World<V> {
     /// The contacts and wall pairs in the order of their lower slot, then their higher one: the
     /// order the response takes them in, whatever order the broad phase found them in.
     fn sort_contacts(&mut self) {
-        sort_pairs(&mut self.contacts, self.critters.slot_count());
+        let slots = self.critters.slot_count();
+        if !sort_pairs(&mut self.contacts, slots)
+            && self.contacts.len() >= RADIX_MIN
+            && LISTED_PER_CONTACT * self.contacts.len() >= self.broad.listed()
+        {
+            self.broad.sort_list();
+        }
         let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
         self.wall_pairs.sort_unstable_by_key(|&(c, a, _)| key(c, a));
     }
@@ -1466,6 +1472,10 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
 /// by radix.
 const RADIX_MIN: usize = 256;
 
+/// The broad phase's Verlet list is sorted once many contacts were (see
+/// [`BroadPhase::sort_list`]): when it holds at most this many pairs per contact.
+const LISTED_PER_CONTACT: usize = 8;
+
 /// Bits per digit of the radix sort of pairs.
 const RADIX_BITS: u32 = 11;
 
@@ -1474,7 +1484,11 @@ const RADIX_BITS: u32 = 11;
 /// Each pair becomes one integer (lower slot, higher slot, then a bit for "the first is the
 /// higher"), sorted a digit at a time from the lowest: a pile's 100,000 contacts in a few
 /// passes over them instead of a comparison sort's 17.
-fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) {
+/// Returns true when they were in that order already (and nothing was done).
+pub(crate) fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) -> bool {
+    if pairs.is_sorted_by_key(|&(a, b)| (a.min(b), a.max(b))) {
+        return true;
+    }
     let bits = usize::BITS - slots.saturating_sub(1).leading_zeros();
     let width = 2 * bits + 1;
     let key = |&(a, b): &(u32, u32)| {
@@ -1482,7 +1496,7 @@ fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) {
     };
     if pairs.len() < RADIX_MIN || width > u64::BITS {
         pairs.sort_unstable_by_key(|&(a, b)| (a.min(b), a.max(b)));
-        return;
+        return false;
     }
     let mut keys: Vec<u64> = pairs.iter().map(key).collect();
     let mut spare = vec![0u64; keys.len()];
@@ -1508,6 +1522,7 @@ fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) {
         let (lo, hi) = ((k >> (bits + 1)) as u32, ((k >> 1) & slot_mask) as u32);
         *pair = if k & 1 == 1 { (hi, lo) } else { (lo, hi) };
     }
+    false
 }
 
 /// How many pairs ahead the rules and narrow stages' pass and the response ask for the critters

@@ -60,7 +60,8 @@ pub const POSITION_SWEEPS: u32 = 3;
 /// The sweeps take the contacts this many apart (see [`World::stage_solve`]).
 const INTERLEAVE: usize = 16;
 
-/// One contact of the solve.
+/// One contact of the velocity sweeps: only what they read, so that the rows of a large pile
+/// stay in the core's own cache over the sweeps.
 #[derive(Clone, Copy, Debug)]
 struct Row<V> {
     /// Caller's and arg's slots.
@@ -74,6 +75,11 @@ struct Row<V> {
     target: f64,
     /// Accumulated impulse on the arg along `n`.
     impulse: f64,
+}
+
+/// The rest of a contact, beside its [`Row`]: what the position sweeps and the events need.
+#[derive(Clone, Copy, Debug)]
+struct Rest {
     /// Overlap found by the narrow phase (the position sweeps hold the normal and follow the
     /// overlap to first order in the pair's moves).
     depth: f64,
@@ -83,16 +89,24 @@ struct Row<V> {
     event: u32,
 }
 
+/// A critter's velocity and inverse mass, read together by every row.
+#[derive(Clone, Copy, Debug)]
+struct Body<V> {
+    vel: V,
+    inv_mass: f64,
+}
+
 /// The solve's working arrays, kept between steps only to save allocations.
 #[derive(Debug)]
 pub(crate) struct Scratch<V> {
     rows: Vec<Row<V>>,
+    rests: Vec<Rest>,
     spare: Vec<Row<V>>,
-    /// Velocity, position shift, position and inverse mass by slot.
-    vel: Vec<V>,
+    spare_rests: Vec<Rest>,
+    /// Velocity and inverse mass, position shift and position by slot.
+    bodies: Vec<Body<V>>,
     shift: Vec<V>,
     pos: Vec<V>,
-    inv_mass: Vec<f64>,
     plain: Vec<(u32, u32)>,
     /// The rows' pair keys, in the order the rows were built.
     keys: Vec<u64>,
@@ -105,11 +119,12 @@ impl<V> Default for Scratch<V> {
     fn default() -> Self {
         Scratch {
             rows: Vec::new(),
+            rests: Vec::new(),
             spare: Vec::new(),
-            vel: Vec::new(),
+            spare_rests: Vec::new(),
+            bodies: Vec::new(),
             shift: Vec::new(),
             pos: Vec::new(),
-            inv_mass: Vec::new(),
             plain: Vec::new(),
             keys: Vec::new(),
             warm: Vec::new(),
@@ -150,27 +165,31 @@ impl<V: Vector> World<V> {
         result?;
 
         // 2. The rows, where the hooks left the critters.
-        s.vel.clear();
+        s.bodies.clear();
         s.pos.clear();
-        s.inv_mass.clear();
         for slot in self.critters.slot_slice() {
             match slot {
                 Some(c) if c.alive => {
-                    s.vel.push(c.vel);
+                    s.bodies.push(Body {
+                        vel: c.vel,
+                        inv_mass: c.inv_mass(),
+                    });
                     s.pos.push(c.pos);
-                    s.inv_mass.push(c.inv_mass());
                 }
                 _ => {
-                    s.vel.push(V::zero());
+                    s.bodies.push(Body {
+                        vel: V::zero(),
+                        inv_mass: 0.0,
+                    });
                     s.pos.push(V::zero());
-                    s.inv_mass.push(0.0);
                 }
             }
         }
         s.shift.clear();
-        s.shift.extend_from_slice(&s.vel);
+        s.shift.extend(s.bodies.iter().map(|body| body.vel));
         let resting = RESTING_STEPS * self.gravity.length() * self.dt;
         s.rows.clear();
+        s.rests.clear();
         s.keys.clear();
         let first_event = self.events.collisions.len();
         let mut warm = Warm::new(&s.warm);
@@ -184,11 +203,12 @@ impl<V: Vector> World<V> {
             let Some(c) = crate::response::contact_between(&self.topo, ca, cb) else {
                 continue;
             };
-            let (ia, ib) = (s.inv_mass[a as usize], s.inv_mass[b as usize]);
+            let (ba, bb) = (s.bodies[a as usize], s.bodies[b as usize]);
+            let (ia, ib) = (ba.inv_mass, bb.inv_mass);
             if ia + ib == 0.0 {
                 continue; // two fixed critters: nothing can move
             }
-            let v0 = (s.vel[b as usize] - s.vel[a as usize]).dot(c.normal);
+            let v0 = (bb.vel - ba.vel).dot(c.normal);
             let e = ca.restitution.min(cb.restitution);
             let scale = match (ca.is_wall(), cb.is_wall()) {
                 (true, _) => cb.radius,
@@ -207,9 +227,11 @@ impl<V: Vector> World<V> {
                 k: 1.0 / (ia + ib),
                 target: if v0 < -resting { -e * v0 } else { 0.0 },
                 impulse: start,
+            });
+            s.rests.push(Rest {
                 depth: c.depth,
                 scale,
-                event: s.rows.len() as u32,
+                event: s.rests.len() as u32,
             });
             self.events.collisions.push(CollisionEvent {
                 caller: ca.id,
@@ -222,29 +244,34 @@ impl<V: Vector> World<V> {
 
         for row in &s.rows {
             let (a, b) = (row.a as usize, row.b as usize);
-            s.vel[a] -= row.n * (row.impulse * s.inv_mass[a]);
-            s.vel[b] += row.n * (row.impulse * s.inv_mass[b]);
+            let ja = row.impulse * s.bodies[a].inv_mass;
+            let jb = row.impulse * s.bodies[b].inv_mass;
+            s.bodies[a].vel -= row.n * ja;
+            s.bodies[b].vel += row.n * jb;
         }
 
         // Rows next to each other in the contact order mostly share a critter, and each would
         // wait for the one before it to store its velocity: taken INTERLEAVE apart, the sweeps'
         // neighbours are mostly independent and their work overlaps.
         s.spare.clear();
+        s.spare_rests.clear();
         for start in 0..INTERLEAVE.min(s.rows.len()) {
-            s.spare
-                .extend(s.rows.iter().skip(start).step_by(INTERLEAVE));
+            s.spare.extend(s.rows[start..].iter().step_by(INTERLEAVE));
+            s.spare_rests
+                .extend(s.rests[start..].iter().step_by(INTERLEAVE));
         }
         std::mem::swap(&mut s.rows, &mut s.spare);
+        std::mem::swap(&mut s.rests, &mut s.spare_rests);
 
         // 3. Velocities: sweeps of sequential impulses, alternately forwards and backwards.
         for sweep in 0..sweeps {
             if sweep % 2 == 0 {
                 for row in s.rows.iter_mut() {
-                    push_velocities(row, &mut s.vel, &s.inv_mass);
+                    push_velocities(row, &mut s.bodies);
                 }
             } else {
                 for row in s.rows.iter_mut().rev() {
-                    push_velocities(row, &mut s.vel, &s.inv_mass);
+                    push_velocities(row, &mut s.bodies);
                 }
             }
         }
@@ -254,24 +281,24 @@ impl<V: Vector> World<V> {
         // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
         // before the solve.
         let dt = self.dt;
-        for (shift, &v) in s.shift.iter_mut().zip(&s.vel) {
-            *shift = (v - *shift) * dt;
+        for (shift, body) in s.shift.iter_mut().zip(&s.bodies) {
+            *shift = (body.vel - *shift) * dt;
         }
 
         // 4. Positions: part of each overlap removed, velocities untouched.
         for _ in 0..POSITION_SWEEPS {
             let mut deepest = f64::NEG_INFINITY;
-            for row in s.rows.iter_mut() {
+            for (row, rest) in s.rows.iter().zip(&s.rests) {
                 let (a, b) = (row.a as usize, row.b as usize);
                 let n = row.n;
-                let depth = row.depth - (s.shift[b] - s.shift[a]).dot(n);
-                let slop = SLOP * row.scale;
+                let depth = rest.depth - (s.shift[b] - s.shift[a]).dot(n);
+                let slop = SLOP * rest.scale;
                 deepest = deepest.max(depth - 3.0 * slop);
-                let fix = (POSITION_SHARE * (depth - slop)).min(LARGEST_CORRECTION * row.scale);
+                let fix = (POSITION_SHARE * (depth - slop)).min(LARGEST_CORRECTION * rest.scale);
                 if fix > 0.0 {
                     let push = fix * row.k;
-                    s.shift[a] -= n * (push * s.inv_mass[a]);
-                    s.shift[b] += n * (push * s.inv_mass[b]);
+                    s.shift[a] -= n * (push * s.bodies[a].inv_mass);
+                    s.shift[b] += n * (push * s.bodies[b].inv_mass);
                 }
             }
             if deepest <= 0.0 {
@@ -280,11 +307,11 @@ impl<V: Vector> World<V> {
         }
 
         // 5. Back to the critters; the events get their impulses.
-        for row in &s.rows {
+        for (row, rest) in s.rows.iter().zip(&s.rests) {
             if let Some(event) = self
                 .events
                 .collisions
-                .get_mut(first_event + row.event as usize)
+                .get_mut(first_event + rest.event as usize)
             {
                 event.impulse = row.impulse;
             }
@@ -313,8 +340,8 @@ impl<V: Vector> World<V> {
         if !s.rows.is_empty() {
             let slots = self.critters.slots_mut_moving().iter_mut().enumerate();
             for (i, c) in slots.filter_map(|(i, c)| Some((i, c.as_mut()?))) {
-                if s.inv_mass[i] > 0.0 {
-                    c.vel = s.vel[i];
+                if s.bodies[i].inv_mass > 0.0 {
+                    c.vel = s.bodies[i].vel;
                     c.pos = s.pos[i] + s.shift[i];
                 }
             }
@@ -388,12 +415,12 @@ impl<'a> Warm<'a> {
 
 /// One contact's impulse of a velocity sweep.
 #[inline]
-fn push_velocities<V: Vector>(row: &mut Row<V>, vel: &mut [V], inv_mass: &[f64]) {
+fn push_velocities<V: Vector>(row: &mut Row<V>, bodies: &mut [Body<V>]) {
     let (a, b) = (row.a as usize, row.b as usize);
-    let vn = (vel[b] - vel[a]).dot(row.n);
+    let vn = (bodies[b].vel - bodies[a].vel).dot(row.n);
     let total = (row.impulse - (vn - row.target) * row.k).max(0.0);
     let j = total - row.impulse;
     row.impulse = total;
-    vel[a] -= row.n * (j * inv_mass[a]);
-    vel[b] += row.n * (j * inv_mass[b]);
+    bodies[a].vel -= row.n * (j * bodies[a].inv_mass);
+    bodies[b].vel += row.n * (j * bodies[b].inv_mass);
 }
