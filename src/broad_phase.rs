@@ -821,7 +821,7 @@ fn retest<V: Vector, O: Objects<V> + ?Sized>(
 fn merge_tail(pairs: &mut Vec<(u32, u32)>, start: usize) {
     let key = |&(a, b): &(u32, u32)| (a.min(b), a.max(b));
     pairs[start..].sort_unstable_by_key(key);
-    let mut tail = pairs.split_off(start);
+    let tail = pairs.split_off(start);
     let (mut i, mut j) = (start, tail.len());
     pairs.resize(start + tail.len(), (0, 0));
     // From the back: each place is written after the pair it held was read.
@@ -835,7 +835,6 @@ fn merge_tail(pairs: &mut Vec<(u32, u32)>, start: usize) {
             j -= 1;
         }
     }
-    tail.clear();
 }
 
 /// The tag bit of a wall's [`CellBox`] and [`Bound`].
