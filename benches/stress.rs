@@ -8,7 +8,10 @@
 //! * `pile_9_layers`, `pile_90_layers`: disks of radius 0.5 dropped under gravity (restitution
 //!   0.5) in a box 1000 or 100 wide and settled for 900 steps into a pile about 9 or 90 layers
 //!   deep, so nearly every disk touches its neighbours (and `pile_9_layers_solve_8`, the
-//!   9-layer pile dropped, settled and stepped under `solve:8`, its contacts solved together).
+//!   9-layer pile dropped, settled and stepped under `solve:8`, its contacts solved together:
+//!   settled, it sleeps, as it would in Box2D or Rapier; `pile_9_layers_solve_8_awake` is the
+//!   same with sleep off, every contact solved every step; `pile_90_layers_solve_8` the deep
+//!   pile under `solve:8`).
 //!
 //! `cargo bench --bench stress`; `docs/performance.md` has the figures. The target is each
 //! scene within 3x of the uniform gas per critter.
@@ -101,17 +104,18 @@ fn radii_x100_with(mode: BroadPhaseMode) -> World<DVec2> {
 /// Disks of radius 0.5 on a loose grid (spacing 1.5) in a box `w` wide, dropped under gravity
 /// with restitution 0.5 and settled for 900 steps.
 fn pile(w: f64) -> World<DVec2> {
-    pile_under(w, Method::Discrete)
+    pile_under(w, Method::Discrete, false)
 }
 
-/// [`pile`], dropped, settled and stepped under `method`.
-fn pile_under(w: f64, method: Method) -> World<DVec2> {
+/// [`pile`], dropped, settled and stepped under `method`, with sleep on or off.
+fn pile_under(w: f64, method: Method, sleep: bool) -> World<DVec2> {
     let spacing = 1.5;
     let per_row = (w / spacing) as usize;
     let rows = N.div_ceil(per_row);
     let h = rows as f64 * spacing + 2.0;
     let mut world = walled(w, h, DVec2::new(0.0, -9.81), BroadPhaseMode::Auto);
     world.set_method(method).expect("a method");
+    world.set_sleep(sleep);
     let mut rng = Rng::new(3);
     for i in 0..N {
         let pos = DVec2::new(
@@ -139,7 +143,13 @@ fn stress(c: &mut Criterion) {
         ("pile_9_layers", || pile(1000.0)),
         ("pile_90_layers", || pile(100.0)),
         ("pile_9_layers_solve_8", || {
-            pile_under(1000.0, Method::Solve(8))
+            pile_under(1000.0, Method::Solve(8), true)
+        }),
+        ("pile_9_layers_solve_8_awake", || {
+            pile_under(1000.0, Method::Solve(8), false)
+        }),
+        ("pile_90_layers_solve_8", || {
+            pile_under(100.0, Method::Solve(8), true)
         }),
     ] {
         let mut world = build();
@@ -148,8 +158,9 @@ fn stress(c: &mut Criterion) {
         });
         let stats = world.stats();
         eprintln!(
-            "{name}: {} critters, {} contacts and {} pair tests in the last step, {} list rebuilds, {} repairs",
+            "{name}: {} critters ({} asleep), {} contacts and {} pair tests in the last step, {} list rebuilds, {} repairs",
             world.critters().len(),
+            world.sleepers(),
             stats.contacts,
             stats.pair_tests,
             world.broad_phase_rebuilds(),

@@ -56,6 +56,13 @@ pub(crate) trait Objects<V: Vector>: Sync {
     fn stride(&self, _i: usize) -> f64 {
         0.0
     }
+    /// True when the object at index `i` stays where it is this step and needs no test against
+    /// another such object (a sleeper or a wall, src/method/sleep.rs): the kept Verlet list
+    /// drops their pairs without reading the objects.
+    #[inline]
+    fn still(&self, _i: usize) -> bool {
+        false
+    }
 }
 
 /// Steps a fast object's bound in the Verlet list is made to last at its speed at the build:
@@ -799,21 +806,30 @@ const PAIRS_AHEAD: usize = 8;
 
 /// The pairs of `pairs` (indices) whose exact boxes overlap, by slot, pushed onto `out`. The
 /// objects of the pair [`PAIRS_AHEAD`] places on are asked for while this one is tested: the
-/// world reads them from its critters, scattered over memory, and the loads overlap.
+/// world reads them from its critters, scattered over memory, and the loads overlap. Pairs of
+/// two still objects are skipped unread. Returns how many pairs were tested.
 #[inline]
 fn retest<V: Vector, O: Objects<V> + ?Sized>(
     objs: &O,
     topo: &Topology<V>,
     pairs: &[(u32, u32)],
     out: &mut Vec<(u32, u32)>,
-) {
+) -> u64 {
+    let still = |&(i, j): &(u32, u32)| objs.still(i as usize) && objs.still(j as usize);
+    let mut tested = 0;
     for (k, pair) in pairs.iter().enumerate() {
-        if let Some(&(i, j)) = pairs.get(k + PAIRS_AHEAD) {
-            objs.prefetch(i as usize);
-            objs.prefetch(j as usize);
+        if let Some(ahead) = pairs.get(k + PAIRS_AHEAD) {
+            if !still(ahead) {
+                objs.prefetch(ahead.0 as usize);
+                objs.prefetch(ahead.1 as usize);
+            }
         }
-        out.extend(exact(objs, topo, pair));
+        if !still(pair) {
+            tested += 1;
+            out.extend(exact(objs, topo, pair));
+        }
     }
+    tested
 }
 
 /// Sorts the pairs from `start` on by their lower index, then their higher one, and merges them
@@ -987,25 +1003,25 @@ impl<V: Vector> BroadPhase<V> {
             crate::world::sort_pairs(&mut self.list.pairs, objs.slots());
             self.list.sorted = true;
         }
-        self.tests += self.list.pairs.len() as u64;
         if objs.slots() >= crate::world::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread count.
             use rayon::prelude::*;
-            let parts: Vec<Vec<(u32, u32)>> = self
+            let parts: Vec<(u64, Vec<(u32, u32)>)> = self
                 .list
                 .pairs
                 .par_chunks(4096)
                 .map(|chunk| {
                     let mut part = Vec::new();
-                    retest(objs, topo, chunk, &mut part);
-                    part
+                    let tested = retest(objs, topo, chunk, &mut part);
+                    (tested, part)
                 })
                 .collect();
-            for part in parts {
+            for (tested, part) in parts {
+                self.tests += tested;
                 out.extend(part);
             }
         } else {
-            retest(objs, topo, &self.list.pairs, out);
+            self.tests += retest(objs, topo, &self.list.pairs, out);
         }
     }
 

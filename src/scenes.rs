@@ -57,6 +57,14 @@ impl AnyWorld {
     pub fn auto_choice(&self) -> Option<(crate::method::Method, String)> {
         both!(self, w => w.auto_choice().cloned())
     }
+    /// How many critters sleep (under `solve:n`, [`crate::method::sleep`]).
+    pub fn sleepers(&self) -> usize {
+        both!(self, w => w.sleepers())
+    }
+    /// True when critters may sleep under `solve:n`.
+    pub fn sleep_allowed(&self) -> bool {
+        both!(self, w => w.sleep_allowed())
+    }
     /// Simulated time.
     pub fn time(&self) -> f64 {
         both!(self, w => w.time())

@@ -63,6 +63,8 @@ pub struct WorldConfig<V: Vector> {
     pub broad_phase: BroadPhaseMode,
     /// Collision method (see [`crate::method`]).
     pub method: Method,
+    /// Whether critters at rest may sleep under `solve:n` ([`crate::method::sleep`]).
+    pub sleep: bool,
 }
 
 impl<V: Vector> WorldConfig<V> {
@@ -77,6 +79,7 @@ impl<V: Vector> WorldConfig<V> {
             seed: 0,
             broad_phase: BroadPhaseMode::Auto,
             method: Method::Discrete,
+            sleep: true,
         }
     }
     /// With collision method `m`.
@@ -107,6 +110,11 @@ impl<V: Vector> WorldConfig<V> {
     /// With broad-phase algorithm `mode`.
     pub fn broad_phase(mut self, mode: BroadPhaseMode) -> Self {
         self.broad_phase = mode;
+        self
+    }
+    /// With sleep under `solve:n` allowed (the default) or not.
+    pub fn sleep(mut self, on: bool) -> Self {
+        self.sleep = on;
         self
     }
 
@@ -250,6 +258,8 @@ pub struct World<V: Vector> {
     pub(crate) auto_choice: Option<(Method, String)>,
     pub(crate) flight: crate::method::flight::Scratch<V>,
     pub(crate) solve: crate::method::solve::Scratch<V>,
+    /// Who sleeps under `solve:n` ([`crate::method::sleep`]).
+    pub(crate) sleep: crate::method::sleep::Sleep<V>,
 }
 
 impl<V: Vector> World<V> {
@@ -285,6 +295,7 @@ impl<V: Vector> World<V> {
             auto_choice: None,
             flight: Default::default(),
             solve: Default::default(),
+            sleep: crate::method::sleep::Sleep::new(config.sleep),
         })
     }
 
@@ -415,6 +426,7 @@ impl<V: Vector> World<V> {
         self.auto_choice = None;
         self.flight = Default::default();
         self.solve = Default::default();
+        self.sleep.forget();
         Ok(())
     }
 
@@ -450,6 +462,74 @@ impl<V: Vector> World<V> {
         }
         self.solve.warm = warm;
         Ok(())
+    }
+
+    /// Under `solve:n` with gravity, the critters' counts of quiet steps that are not 0, as (id,
+    /// count, island) in ascending slots. A count of [`crate::method::sleep::SLEEP_STEPS`] means
+    /// asleep, and then the island is named by one of its sleepers (see
+    /// [`crate::method::sleep`]); it is `None` for the others.
+    pub fn quiet_steps(&self) -> impl Iterator<Item = (CritterId, u16, Option<CritterId>)> + '_ {
+        self.sleep.counts().filter_map(|(i, q, island)| {
+            let c = self.critters.slot(i as u32)?;
+            let named = (q >= crate::method::sleep::SLEEP_STEPS)
+                .then(|| self.critters.slot(island))
+                .flatten()
+                .map(|c| c.id);
+            Some((c.id, q, named))
+        })
+    }
+
+    /// Restores the counts [`World::quiet_steps`] gave, after [`World::restore`]. Refuses ids
+    /// this world does not have, counts out of range, slots out of order, and sleepers without
+    /// an island named by one of them.
+    pub(crate) fn set_quiet_steps(
+        &mut self,
+        counts: impl Iterator<Item = (CritterId, u16, Option<CritterId>)>,
+    ) -> Result<(), String> {
+        use crate::method::sleep::SLEEP_STEPS;
+        let mut list: Vec<(u32, u16, u32)> = Vec::new();
+        for (id, q, island) in counts {
+            let known = |id: CritterId| self.critters.get(id).is_some_and(|c| !c.is_wall());
+            let named = match island {
+                Some(named) if q == SLEEP_STEPS && known(named) => Some(named.index),
+                None if q < SLEEP_STEPS => Some(0),
+                _ => None,
+            };
+            let Some(named) = named.filter(|_| known(id) && q > 0 && q <= SLEEP_STEPS) else {
+                return Err(format!(
+                    "the state's quiet steps ({id}, {q}, {island:?}) are not those of one of its critters"
+                ));
+            };
+            if list.last().is_some_and(|&(s, _, _)| s >= id.index) {
+                return Err("the state's quiet steps are out of order".into());
+            }
+            list.push((id.index, q, named));
+        }
+        self.sleep.restore(&list, self.critters.slot_slice())
+    }
+
+    /// Lets critters sleep under `solve:n` (the default) or keeps every one awake
+    /// ([`crate::method::sleep`]). Turning it off wakes every sleeper.
+    pub fn set_sleep(&mut self, on: bool) {
+        self.sleep.off = !on;
+        if !on {
+            self.sleep.clear();
+        }
+    }
+
+    /// True when critters may sleep under `solve:n`.
+    pub fn sleep_allowed(&self) -> bool {
+        !self.sleep.off
+    }
+
+    /// True when critter `id` sleeps.
+    pub fn is_asleep(&self, id: CritterId) -> bool {
+        self.critters.get(id).is_some() && self.sleep.asleep(id.index as usize)
+    }
+
+    /// How many critters sleep.
+    pub fn sleepers(&self) -> usize {
+        self.sleep.count()
     }
 
     /// The critters.
@@ -535,7 +615,8 @@ impl<V: Vector> World<V> {
     /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
     /// overwhelming probability) bit-identical worlds. It covers the step count, dt, the
     /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
-    /// radius, mass, priority, restitution, health and properties.
+    /// radius, mass, priority, restitution, health and properties, and under `solve:n` the
+    /// critters' counts of quiet steps towards sleep.
     pub fn state_hash(&self) -> u64 {
         self.state_hash_and_totals().0
     }
@@ -561,6 +642,12 @@ impl<V: Vector> World<V> {
             h.words(w);
         }
         h.word(pass.props);
+        // The quiet steps, when there are any (a world without them hashes as it did before
+        // sleep existed).
+        for (slot, q, island) in self.sleep.counts() {
+            h.word((slot as u64) << 16 | u64::from(q));
+            h.word(u64::from(island));
+        }
         (h.finish(), pass.energy, pass.momentum)
     }
 
@@ -750,6 +837,10 @@ impl<V: Vector> World<V> {
         if c.is_wall() {
             self.walls.retain(|&w| w != id);
         }
+        // What rested on it wakes.
+        let gone = [(id.index as usize, c.pos, c.radius)];
+        self.sleep
+            .removed(&self.topo, &gone, self.critters.slot_slice());
         Ok(c)
     }
 
@@ -812,6 +903,13 @@ impl<V: Vector> World<V> {
         if !matches!(method, Method::Solve(_)) {
             self.solve.warm.clear(); // kept only from one solve step to the next
         }
+        self.sleep.active =
+            matches!(method, Method::Solve(_)) && !self.sleep.off && self.gravity != V::zero();
+        if self.sleep.active {
+            self.sleep.check(self.critters.slot_slice());
+        } else {
+            self.sleep.clear();
+        }
         match method {
             Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
             Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
@@ -871,6 +969,13 @@ impl<V: Vector> World<V> {
             clock = now;
         };
         self.stage_broad_phase();
+        if self.sleep.any() {
+            // Two sleepers, or a sleeper and a wall, stay as they were.
+            let still = self.sleep.still();
+            let is_still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
+            self.candidates
+                .retain(|&(a, b)| !(is_still(a) && is_still(b)));
+        }
         lap(&mut stats.broad_phase);
         let ruled = match self.rules_and_narrow_phase_in_one_pass() {
             Some(ruled) => ruled,
@@ -934,8 +1039,10 @@ impl<V: Vector> World<V> {
         let (g, topo) = (self.gravity, self.topo);
         let dv = g * dt;
         // Each critter moves on its own, so any split over threads gives the same bits.
-        let step = move |c: &mut Critter<V>| {
-            if !c.alive || c.is_wall() {
+        // Sleepers stay where they are, unpulled (src/method/sleep.rs).
+        let still = self.sleep.still();
+        let step = move |i: usize, c: &mut Critter<V>| {
+            if !c.alive || c.is_wall() || still.get(i).copied().unwrap_or(false) {
                 return;
             }
             if !c.fixed {
@@ -975,7 +1082,7 @@ impl<V: Vector> World<V> {
                             held = held && broad.list_holds(&topo, i, None);
                             continue;
                         };
-                        step(c);
+                        step(i, c);
                         seen = seen.and(Survey::of(c));
                         if c.alive && c.is_wall() {
                             walls += 1;
@@ -996,7 +1103,12 @@ impl<V: Vector> World<V> {
                     .fold(Survey::default(), |s, &(c, _, _)| s.and(c)),
             });
         } else {
-            self.critters.iter_mut_moving().for_each(step);
+            let slots = self.critters.slots_mut_moving().iter_mut().enumerate();
+            slots.for_each(|(i, c)| {
+                if let Some(c) = c {
+                    step(i, c)
+                }
+            });
         }
     }
 
@@ -1029,6 +1141,7 @@ impl<V: Vector> World<V> {
             slots: self.critters.slot_slice(),
             wall_pad: seen.largest_radius,
             dt: self.dt,
+            still: self.sleep.still(),
         };
         // The move checked every slot but the live walls' against the Verlet list; the walls
         // are checked here, and must be the ones it counted.
@@ -1334,13 +1447,21 @@ impl<V: Vector> World<V> {
     }
 
     fn stage_lifecycle(&mut self) -> Result<(), Error> {
+        let mut gone = Vec::new();
         for id in std::mem::take(&mut self.pending.deaths) {
             self.events.deaths.push(id);
             if let Some(c) = self.critters.remove(id) {
                 if c.is_wall() {
                     self.walls.retain(|&w| w != id);
                 }
+                if self.sleep.active {
+                    gone.push((id.index as usize, c.pos, c.radius));
+                }
             }
+        }
+        if !gone.is_empty() {
+            self.sleep
+                .removed(&self.topo, &gone, self.critters.slot_slice());
         }
         for spec in std::mem::take(&mut self.pending.spawns) {
             let id = self.spawn(spec)?;
@@ -1438,6 +1559,8 @@ struct Slots<'a, V: Vector> {
     wall_pad: f64,
     /// The step's length, for the critters' strides.
     dt: f64,
+    /// Sleepers and walls by slot, or empty (see [`Objects::still`]).
+    still: &'a [bool],
 }
 
 impl<V: Vector> Objects<V> for Slots<'_, V> {
@@ -1457,6 +1580,11 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
     #[inline]
     fn prefetch(&self, i: usize) {
         prefetch(self.slots.get(i));
+    }
+
+    #[inline]
+    fn still(&self, i: usize) -> bool {
+        self.still.get(i).copied().unwrap_or(false)
     }
 
     #[inline]

@@ -868,15 +868,21 @@ fn a_solve_run_is_replayed_from_its_keyframes_with_its_contact_impulses() {
         carried > 0,
         "test setup: the keyframes carry contact impulses"
     );
-    for step in [60, 130, 239] {
-        let (shown, source) = state_at_step(&r, step).expect("a step");
-        let key = r.keyframe_at_or_before(step).expect("a keyframe");
+    replayed_from_keyframes_as_recorded(&all, &r, &[60, 130, 239]);
+}
+
+/// Each of `steps`, replayed from the keyframe before it in `sparse`, is the state `all` (every
+/// step recorded) holds for it; and the whole of `sparse` verifies.
+fn replayed_from_keyframes_as_recorded(all: &Path, sparse: &Recording, steps: &[u64]) {
+    for &step in steps {
+        let (shown, source) = state_at_step(sparse, step).expect("a step");
+        let key = sparse.keyframe_at_or_before(step).expect("a keyframe");
         assert_eq!(
             source,
             StateSource::Restored { keyframe: key },
             "step {step}"
         );
-        let truth = state_at(&all, step)
+        let truth = state_at(all, step)
             .expect("read")
             .expect("every step recorded");
         assert_eq!(
@@ -884,7 +890,49 @@ fn a_solve_run_is_replayed_from_its_keyframes_with_its_contact_impulses() {
             None,
             "step {step}"
         );
+        assert_eq!(truth.quiet_steps, shown.quiet_steps, "step {step}");
+        assert_eq!(
+            truth.contact_impulses, shown.contact_impulses,
+            "step {step}"
+        );
     }
-    let report = verify(&r, |_| {}).expect("verifies");
+    let report = verify(sparse, |_| {}).expect("verifies");
     assert!(report.passed(), "{report:?}");
+}
+
+/// Under `solve:n` the pile falls asleep: the full states carry each critter's count of quiet
+/// steps and each sleeper's island, so a step replayed from the keyframe before it is still the
+/// recorded one (sleepers stay put, the counting ones fall asleep on the same step), and the
+/// whole file verifies.
+#[test]
+fn a_sleeping_pile_is_replayed_from_its_keyframes_with_its_quiet_steps() {
+    let dir = tmp("restore_sleep");
+    let (all, sparse) = (dir.join("every1.mcap"), dir.join("every40.mcap"));
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/pile.rhai");
+    let args = [scene.to_str().unwrap(), "--steps", "600"];
+    record(&all, &[&args[..], &["--record-every", "1"]].concat());
+    record(&sparse, &[&args[..], &["--record-every", "40"]].concat());
+    let r = Recording::open(&sparse).expect("open");
+    let (mut counting, mut asleep) = (0, 0);
+    for_each_state(&sparse, |s| {
+        counting += s.quiet_steps.iter().filter(|q| q.1 < 30).count();
+        asleep += s.quiet_steps.iter().filter(|q| q.1 == 30).count();
+        Ok(Flow::Continue)
+    })
+    .expect("states");
+    assert!(
+        counting > 0 && asleep > 0,
+        "test setup: the keyframes carry counting critters ({counting}) and sleepers ({asleep})"
+    );
+    let mut steps: Vec<u64> = Vec::new();
+    for_each_state(&all, |s| {
+        let before = s.quiet_steps.iter().filter(|q| q.1 == 30).count();
+        if before > 0 && steps.len() < 3 && s.step % 40 != 0 {
+            steps.push(s.step);
+        }
+        Ok(Flow::Continue)
+    })
+    .expect("states");
+    steps.extend([r.last_step() - 1]);
+    replayed_from_keyframes_as_recorded(&all, &r, &steps);
 }

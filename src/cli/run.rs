@@ -169,6 +169,18 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if let Some((chose, why)) = scene.world.auto_choice() {
         writeln!(out, "auto chose   {chose} (last step): {why}")?;
     }
+    if matches!(method, crate::method::Method::Solve(_)) {
+        let how = if scene.world.sleep_allowed() {
+            "critters at rest under gravity sleep; `sleep: false` in world(#{ ... }) turns it off"
+        } else {
+            "sleep is off in this scene"
+        };
+        writeln!(
+            out,
+            "asleep       {} critters ({how})",
+            scene.world.sleepers()
+        )?;
+    }
     let t = scene.world.totals();
     if t.events > 0 || t.budget_exceeded > 0 {
         writeln!(

@@ -8,7 +8,7 @@
 //!   collisions, wall hits, border and cell crossings processed in time order.
 //! * [`Method::Solve`]: the discrete step with its contacts solved together ([`solve`]): `n`
 //!   sweeps of sequential impulses over every contact, then a partial position correction, so
-//!   piles and stacks come to rest.
+//!   piles and stacks come to rest; under gravity, islands at rest then sleep ([`sleep`]).
 //! * [`Method::Auto`]: discrete or swept per step from the scene's speeds, and within a swept
 //!   step predictions only for the critters that are fast or may meet something ([`auto`]).
 //!
@@ -20,6 +20,7 @@ pub mod auto;
 pub mod event;
 pub(crate) mod flight;
 mod queue;
+pub mod sleep;
 pub mod solve;
 pub mod swept;
 pub mod toi;

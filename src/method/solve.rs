@@ -31,7 +31,9 @@
 //!
 //! The impulses carried to the next step are the only state the solve keeps
 //! ([`World::contact_impulses`]); recordings write them with every full state, so a run replays
-//! exactly from any recorded state.
+//! exactly from any recorded state. Under gravity, critters at rest fall asleep and leave the
+//! step until something wakes them ([`crate::method::sleep`]); their contacts' impulses are kept
+//! for then.
 
 use crate::context::CollisionEvent;
 use crate::error::Error;
@@ -163,16 +165,25 @@ impl<V: Vector> World<V> {
         });
         self.wall_pairs = wall_pairs;
         result?;
+        self.sleep.flush(); // the islands of the sleepers the hooks took
 
         // 2. The rows, where the hooks left the critters.
         s.bodies.clear();
         s.pos.clear();
-        for slot in self.critters.slot_slice() {
+        let still = self.sleep.still();
+        // No contacts to solve (a pile asleep): no bodies either.
+        let slots = match s.plain.is_empty() {
+            true => &[][..],
+            false => self.critters.slot_slice(),
+        };
+        for (i, slot) in slots.iter().enumerate() {
             match slot {
                 Some(c) if c.alive => {
+                    // To an awake critter a sleeper is as heavy as a wall.
+                    let asleep = still.get(i).copied().unwrap_or(false);
                     s.bodies.push(Body {
                         vel: c.vel,
-                        inv_mass: c.inv_mass(),
+                        inv_mass: if asleep { 0.0 } else { c.inv_mass() },
                     });
                     s.pos.push(c.pos);
                 }
@@ -322,6 +333,15 @@ impl<V: Vector> World<V> {
             .iter()
             .map(|e| e.impulse)
             .collect();
+        // Pairs of sleepers (or of a sleeper and a wall) had no row: their impulses are kept
+        // as they were, for when the island wakes.
+        let mut asleep = std::mem::take(&mut s.warm);
+        let still = self.sleep.still();
+        let both_still = |key: u64| {
+            let (lo, hi) = ((key >> 32) as usize, (key & 0xffff_ffff) as usize);
+            still.get(lo).copied().unwrap_or(false) && still.get(hi).copied().unwrap_or(false)
+        };
+        asleep.retain(|&(key, _)| both_still(key));
         s.warm.clear();
         let split = s
             .keys
@@ -337,6 +357,10 @@ impl<V: Vector> World<V> {
             }
             *k += 1;
         }
+        if !asleep.is_empty() {
+            let solved = std::mem::take(&mut s.warm);
+            s.warm = merge_by_key(&solved, &asleep);
+        }
         if !s.rows.is_empty() {
             let slots = self.critters.slots_mut_moving().iter_mut().enumerate();
             for (i, c) in slots.filter_map(|(i, c)| Some((i, c.as_mut()?))) {
@@ -348,6 +372,11 @@ impl<V: Vector> World<V> {
         }
         // The hooks or the position sweeps may have pushed a critter across the edge.
         self.wrap_positions();
+        if self.sleep.active {
+            let speed = crate::method::sleep::SLEEP_SPEED_STEPS * self.gravity.length() * dt;
+            self.sleep
+                .after_solve(self.critters.slots_mut_moving(), &self.contacts, speed);
+        }
         Ok(handled + s.rows.len())
     }
 
@@ -362,7 +391,10 @@ impl<V: Vector> World<V> {
     ) -> Result<(), Error> {
         if !self.own_collide(caller) {
             plain.push((caller, arg));
-        } else if self.collide_pair(caller, arg)? {
+            return Ok(());
+        }
+        self.sleep.stir(caller, arg);
+        if self.collide_pair(caller, arg)? {
             *handled += 1;
         }
         Ok(())
@@ -379,6 +411,22 @@ impl<V: Vector> World<V> {
 /// The key of a pair of slots, whichever is the caller: lower slot, then higher.
 pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
     (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+}
+
+/// Two lists ascending by key, with no key in both, merged.
+fn merge_by_key(a: &[(u64, f64)], b: &[(u64, f64)]) -> Vec<(u64, f64)> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        if j == b.len() || (i < a.len() && a[i].0 < b[j].0) {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out
 }
 
 /// Looks up the last step's impulses for keys that come in ascending runs.

@@ -105,6 +105,10 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
             .contact_impulses()
             .map(|(a, b, j)| (id_key(a), id_key(b), Float(j)))
             .collect(),
+        quiet_steps: world
+            .quiet_steps()
+            .map(|(id, q, island)| (id_key(id), q, island.map(id_key)))
+            .collect(),
     };
     for c in world.critters().iter() {
         let id = id_key(c.id());

@@ -215,7 +215,12 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
         .contact_impulses
         .iter()
         .map(|&(a, b, j)| (id_of(a), id_of(b), j.0));
-    w.set_contact_impulses(impulses)
+    w.set_contact_impulses(impulses)?;
+    w.set_quiet_steps(
+        s.quiet_steps
+            .iter()
+            .map(|&(id, q, island)| (id_of(id), q, island.map(id_of))),
+    )
 }
 
 /// The exact state after `step` steps: from the file if it holds that state, else re-simulated

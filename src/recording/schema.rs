@@ -249,6 +249,12 @@ pub struct StateMsg {
     /// needs them to be exact. Empty under the other methods.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact_impulses: Vec<(u64, u64, Float)>,
+    /// Under `solve:n` with gravity, the critters' counts of quiet steps towards sleep that are
+    /// not 0, as (id, count, island) in ascending slots; a count of 30 means asleep, and then
+    /// the island is the id of the sleeper that names it (null for the others). A replay from
+    /// this state needs them to be exact. Empty under the other methods.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub quiet_steps: Vec<(u64, u16, Option<u64>)>,
 }
 
 impl StateMsg {
@@ -538,7 +544,14 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
                 "prefixItems": [ { "type": "integer", "minimum": 0 },
                                  { "type": "integer", "minimum": 0 }, float_schema() ],
                 "minItems": 3, "maxItems": 3,
-            }, "description": "solve:n only: the impulses the step's contacts ended with, which the next step starts from, as [lower id, higher id, impulse] in ascending slots" },
+            }, "description": "solve:n only: the impulses the step's contacts ended with (and those of sleeping contacts, kept for when they wake), which the next step starts from, as [lower id, higher id, impulse] in ascending slots" },
+            "quiet_steps": { "type": "array", "items": {
+                "type": "array",
+                "prefixItems": [ { "type": "integer", "minimum": 0 },
+                                 { "type": "integer", "minimum": 1, "maximum": 30 },
+                                 { "type": ["integer", "null"], "minimum": 0 } ],
+                "minItems": 3, "maxItems": 3,
+            }, "description": "solve:n with gravity only: the critters' counts of quiet steps towards sleep that are not 0, as [id, count, island] in ascending slots; 30 means asleep, and then island is the id of the sleeper that names its island (null for the others)" },
         })),
         &[
             "step",

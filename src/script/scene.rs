@@ -19,7 +19,7 @@ use std::rc::Rc;
 
 /// The keys `world(#{ ... })` accepts.
 const WORLD_KEYS: &[&str] = &[
-    "dim", "size", "min", "border", "gravity", "dt", "seed", "method", "steps",
+    "dim", "size", "min", "border", "gravity", "dt", "seed", "method", "sleep", "steps",
 ];
 
 fn runtime(host: &Host) -> Res<Rc<Runtime>> {
@@ -75,6 +75,11 @@ fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
                     .to_string()
                     .parse::<crate::method::Method>()
                     .map_or_else(fail, Ok)?;
+            }
+            "sleep" => {
+                config.sleep = value
+                    .as_bool()
+                    .map_or_else(|_| fail("sleep must be true or false"), Ok)?
             }
             "steps" => {
                 steps = Some(value.as_int().ok().filter(|s| *s >= 0).map_or_else(
