@@ -122,18 +122,13 @@ impl<V: Vector> Sleep<V> {
             .map(|(i, &q)| (i, q, if q >= SLEEP_STEPS { self.island[i] } else { 0 }))
     }
 
-    /// Everybody awake, every count at 0.
+    /// Everybody awake, every count at 0: the arrays are emptied, and fitted to the slots again
+    /// when next needed (so a world under another method pays nothing per step).
     pub(crate) fn clear(&mut self) {
-        if self.sleepers > 0 {
-            for (still, &q) in self.still.iter_mut().zip(&self.quiet) {
-                if q >= SLEEP_STEPS {
-                    *still = false;
-                }
-            }
-        }
-        if self.quiet.iter().any(|&q| q > 0) {
-            self.quiet.iter_mut().for_each(|q| *q = 0);
-        }
+        self.quiet.clear();
+        self.island.clear();
+        self.rest.clear();
+        self.still.clear();
         self.sleepers = 0;
         self.stirred.clear();
         self.waking.clear();
@@ -185,8 +180,8 @@ impl<V: Vector> Sleep<V> {
         counts: &[(u32, u16, u32)],
         slots: &[Option<Critter<V>>],
     ) -> Result<(), String> {
-        self.fit(slots);
         self.clear();
+        self.fit(slots);
         for &(slot, q, island) in counts {
             let i = slot as usize;
             self.quiet[i] = q.min(SLEEP_STEPS);
