@@ -63,6 +63,11 @@ pub(crate) trait Objects<V: Vector>: Sync {
     fn still(&self, _i: usize) -> bool {
         false
     }
+    /// False when no object is [`Objects::still`], so that the pair loops need not ask.
+    #[inline]
+    fn any_still(&self) -> bool {
+        false
+    }
 }
 
 /// Steps a fast object's bound in the Verlet list is made to last at its speed at the build:
@@ -815,6 +820,16 @@ fn retest<V: Vector, O: Objects<V> + ?Sized>(
     pairs: &[(u32, u32)],
     out: &mut Vec<(u32, u32)>,
 ) -> u64 {
+    if !objs.any_still() {
+        for (k, pair) in pairs.iter().enumerate() {
+            if let Some(ahead) = pairs.get(k + PAIRS_AHEAD) {
+                objs.prefetch(ahead.0 as usize);
+                objs.prefetch(ahead.1 as usize);
+            }
+            out.extend(exact(objs, topo, pair));
+        }
+        return pairs.len() as u64;
+    }
     let still = |&(i, j): &(u32, u32)| objs.still(i as usize) && objs.still(j as usize);
     let mut tested = 0;
     for (k, pair) in pairs.iter().enumerate() {

@@ -434,7 +434,7 @@ impl<V: Vector> World<V> {
     /// (lower id, higher id, impulse) in ascending slots; nothing under the other methods.
     pub fn contact_impulses(&self) -> impl Iterator<Item = (CritterId, CritterId, f64)> + '_ {
         self.solve.warm.iter().filter_map(|&(key, j)| {
-            let (lo, hi) = ((key >> 32) as u32, key as u32);
+            let (lo, hi) = crate::method::unpair_key(key);
             let (a, b) = (self.critters.slot(lo)?, self.critters.slot(hi)?);
             Some((a.id, b.id, j))
         })
@@ -454,7 +454,7 @@ impl<V: Vector> World<V> {
                     "the state's contact impulse ({a}, {b}, {j}) is not between two of its critters in order"
                 ));
             }
-            let key = crate::method::solve::pair_key(a.index, b.index);
+            let key = crate::method::pair_key(a.index, b.index);
             if warm.last().is_some_and(|&(k, _)| k >= key) {
                 return Err("the state's contact impulses are out of order".into());
             }
@@ -1585,6 +1585,11 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
     #[inline]
     fn still(&self, i: usize) -> bool {
         self.still.get(i).copied().unwrap_or(false)
+    }
+
+    #[inline]
+    fn any_still(&self) -> bool {
+        !self.still.is_empty()
     }
 
     #[inline]

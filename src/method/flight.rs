@@ -31,6 +31,7 @@ use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
+use crate::method::pair_key;
 use crate::method::queue::{Owned, Queue};
 use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_wall_ball};
 use crate::rules::PairRule;
@@ -813,10 +814,6 @@ fn predict_shell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64, m
     if t + s <= sc.t_end {
         push(sc, t + s, a, 0, SHELL);
     }
-}
-
-fn pair_key(a: u32, b: u32) -> u64 {
-    ((a.min(b) as u64) << 32) | a.max(b) as u64
 }
 
 #[inline]

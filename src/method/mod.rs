@@ -28,6 +28,17 @@ pub mod toi;
 use std::fmt;
 use std::str::FromStr;
 
+/// The key of a pair of slots, whichever comes first: lower slot, then higher, so that keys sort
+/// by lower slot and then higher.
+pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
+    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+}
+
+/// The (lower, higher) slots of a [`pair_key`].
+pub(crate) fn unpair_key(key: u64) -> (u32, u32) {
+    ((key >> 32) as u32, key as u32)
+}
+
 /// How a world's step finds and resolves collisions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Method {

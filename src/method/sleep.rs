@@ -338,15 +338,14 @@ impl<V: Vector> Sleep<V> {
         if !falling {
             return;
         }
-        // The islands that fall asleep join the sleeping islands they touch.
+        // The islands that fall asleep join the sleeping islands they touch. A critter that has
+        // reached SLEEP_STEPS and is not yet still falls asleep now (it is an islander, quiet
+        // and awake, or its count would be 0).
         let mut joined = false;
         for &(a, b) in contacts {
             let (a, b) = (a as usize, b as usize);
             for (me, other) in [(a, b), (b, a)] {
-                let falls = islander(&slots[me])
-                    && self.quiet[me] >= SLEEP_STEPS
-                    && self.quiet_now[me]
-                    && self.island_of_awake(me);
+                let falls = self.quiet[me] >= SLEEP_STEPS && !self.still[me];
                 if falls && self.asleep_before(other) {
                     let named = self.island[other] as usize;
                     union(&mut self.parent, me, named);
@@ -373,13 +372,8 @@ impl<V: Vector> Sleep<V> {
         }
     }
 
-    /// True for a critter that was awake when this step's island pass began (its `still` flag
-    /// is set only once it has fallen asleep).
-    fn island_of_awake(&self, slot: usize) -> bool {
-        !self.still[slot]
-    }
-
-    /// True for a critter asleep since before this step's island pass.
+    /// True for a critter asleep since before this step's island pass (walls are still too, but
+    /// never asleep).
     fn asleep_before(&self, slot: usize) -> bool {
         self.asleep(slot) && self.still[slot]
     }

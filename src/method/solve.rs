@@ -37,6 +37,7 @@
 
 use crate::context::CollisionEvent;
 use crate::error::Error;
+use crate::method::{pair_key, unpair_key};
 use crate::vector::Vector;
 use crate::world::World;
 
@@ -335,13 +336,16 @@ impl<V: Vector> World<V> {
             .collect();
         // Pairs of sleepers (or of a sleeper and a wall) had no row: their impulses are kept
         // as they were, for when the island wakes.
-        let mut asleep = std::mem::take(&mut s.warm);
         let still = self.sleep.still();
-        let both_still = |key: u64| {
-            let (lo, hi) = ((key >> 32) as usize, (key & 0xffff_ffff) as usize);
-            still.get(lo).copied().unwrap_or(false) && still.get(hi).copied().unwrap_or(false)
+        let both_still = |&&(key, _): &&(u64, f64)| {
+            let (lo, hi) = unpair_key(key);
+            let still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
+            still(lo) && still(hi)
         };
-        asleep.retain(|&(key, _)| both_still(key));
+        let asleep: Vec<(u64, f64)> = match still.is_empty() {
+            true => Vec::new(),
+            false => s.warm.iter().filter(both_still).copied().collect(),
+        };
         s.warm.clear();
         let split = s
             .keys
@@ -406,11 +410,6 @@ impl<V: Vector> World<V> {
             .slot(slot)
             .is_some_and(|c| self.kinds.get(c.kind).has_collide)
     }
-}
-
-/// The key of a pair of slots, whichever is the caller: lower slot, then higher.
-pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
-    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
 }
 
 /// Two lists ascending by key, with no key in both, merged.
