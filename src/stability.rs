@@ -170,10 +170,10 @@ fn max_overlap<V: Vector>(w: &World<V>) -> f64 {
     worst
 }
 
-fn floor_box(method: Method) -> Result<World<DVec2>, Error> {
+fn floor_box(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
     let mut w = World::new(
         WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(11.0, 30.0))
-            .dt(DT)
+            .dt(dt)
             .gravity(DVec2::new(0.0, -9.81))
             .method(method),
     )?;
@@ -195,8 +195,8 @@ fn floor_box(method: Method) -> Result<World<DVec2>, Error> {
 
 /// `rows` rows of touching balls resting on the floor of `floor_box` (a hair apart, hexagonal),
 /// restitution 0.5.
-fn pile(method: Method, rows: usize) -> Result<World<DVec2>, Error> {
-    let mut w = floor_box(method)?;
+fn pile(method: Method, rows: usize, dt: f64) -> Result<World<DVec2>, Error> {
+    let mut w = floor_box(method, dt)?;
     let r = 0.5;
     for row in 0..rows {
         for k in 0..9 {
@@ -216,7 +216,7 @@ fn pile(method: Method, rows: usize) -> Result<World<DVec2>, Error> {
 }
 
 fn resting_pile(method: Method) -> Result<f64, Error> {
-    let mut w = pile(method, 3)?;
+    let mut w = pile(method, 3, DT)?;
     let e0 = total_energy(&w);
     let scale = w
         .critters()
@@ -241,7 +241,7 @@ fn resting_pile(method: Method) -> Result<f64, Error> {
 /// A pile deep enough that the bottom rows carry 20 rows' weight: how far do the balls sink
 /// into each other (the 3-row pile hides this)?
 fn deep_pile(method: Method) -> Result<f64, Error> {
-    let mut w = pile(method, DEEP_PILE_ROWS)?;
+    let mut w = pile(method, DEEP_PILE_ROWS, DT)?;
     w.run(120)?;
     Ok(max_overlap(&w))
 }
@@ -352,7 +352,7 @@ fn overlap_after_30_steps<V: Vector>(mut w: World<V>) -> Result<f64, Error> {
 }
 
 fn collapse_column(method: Method) -> Result<f64, Error> {
-    let mut w = floor_box(method)?;
+    let mut w = floor_box(method, DT)?;
     let r = 0.25;
     let mut ids: Vec<CritterId> = Vec::new();
     for k in 0..6 {
@@ -646,6 +646,31 @@ fn chart_gas(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
     }
     w.set_method(method)?;
     Ok(w)
+}
+
+/// Runs the chart's second sweep, where methods fail on resting contacts: the deep pile
+/// ([`DEEP_PILE_ROWS`] rows under gravity) for two simulated seconds at dt = 1/15 ... 1/240, the
+/// error being the deepest overlap at the end in radii (the stability table's measure).
+pub fn chart_pile_points(methods: &[Method]) -> Result<Vec<ChartPoint>, Error> {
+    let mut out = Vec::new();
+    for &method in methods {
+        for k in 0..5 {
+            let dt = 1.0 / (15.0 * 2f64.powi(k));
+            let mut w = pile(method, DEEP_PILE_ROWS, dt)?;
+            let steps = (2.0 / dt).round() as u64;
+            let n = w.critters().iter().filter(|c| !c.is_wall()).count() as f64;
+            let start = std::time::Instant::now();
+            w.run(steps)?;
+            let cost = start.elapsed().as_secs_f64() / n / 2.0;
+            out.push(ChartPoint {
+                method,
+                dt,
+                cost,
+                error: max_overlap(&w),
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Runs the chart's sweep: each method at dt = 1/15 ... 1/960 over one simulated second, error

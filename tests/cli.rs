@@ -226,6 +226,13 @@ fn every_method_runs_every_shipped_scene_script_and_calls_its_hooks() {
         "{}",
         stdout(&o)
     );
+    // Under gravity auto solves, and says how many critters sleep: the whole pile has come to
+    // rest after 600 steps (10 s).
+    let pile = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/scenes/pile.rhai");
+    let o = critterbox(&["run", pile, "--steps", "600", "--method", "auto"]);
+    let out = stdout(&o);
+    assert!(field(&out, "auto chose").starts_with("solve:8"), "{out}");
+    assert!(field(&out, "asleep").starts_with("240 critters"), "{out}");
 }
 
 #[test]

@@ -1,9 +1,11 @@
-//! `critterbox chart`: cost against error for every method over a sweep of dt, written as
-//! `docs/speed-vs-accuracy.svg` and `.png` (see the README for how to read it). Text is laid out
+//! `critterbox chart`: cost against error for every method over a sweep of dt on two scenes (a
+//! gas, where the error is the position error against the exact run, and a deep pile under
+//! gravity, where it is the deepest overlap), written as `docs/speed-vs-accuracy.svg` and `.png`
+//! (see the README for how to read it). Text is laid out
 //! with a TrueType font (`--font`), for both files.
 
 use crate::method::Method;
-use crate::stability::{chart_points, ChartPoint};
+use crate::stability::{chart_pile_points, chart_points, ChartPoint};
 use anyhow::Context;
 use clap::Args;
 use plotters::coord::Shift;
@@ -25,30 +27,65 @@ pub struct ChartArgs {
     pub font: PathBuf,
 }
 
-const METHODS: [Method; 5] = [
+const METHODS: [Method; 6] = [
     Method::Discrete,
     Method::Substep(4),
     Method::Swept,
     Method::Event,
+    Method::Solve(8),
     Method::Auto,
 ];
 
+/// Each method's colour, in the order of [`METHODS`].
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(214, 39, 40),   // discrete: red
+    RGBColor(44, 160, 44),   // substep: green
+    RGBColor(255, 127, 14),  // swept: orange
+    RGBColor(31, 119, 180),  // event: blue
+    RGBColor(23, 190, 207),  // solve: cyan
+    RGBColor(148, 103, 189), // auto: purple
+];
+
+/// One panel of the chart: its points, title, error axis and where its legend is out of the way.
+struct Panel {
+    points: Vec<ChartPoint>,
+    title: &'static str,
+    error: &'static str,
+    legend: SeriesLabelPosition,
+}
+
 /// Runs the command.
 pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
-    let points = chart_points(&METHODS)?;
-    writeln!(
-        out,
-        "method      dt          cost (s per sim s per critter)  error (radii)"
-    )?;
-    for p in &points {
+    let panels = [
+        Panel {
+            points: chart_points(&METHODS)?,
+            title: "100-disk gas, 1 s, dt 1/15 to 1/960",
+            error: "RMS position error against the exact event-driven run (radii)",
+            legend: SeriesLabelPosition::UpperMiddle,
+        },
+        Panel {
+            points: chart_pile_points(&METHODS)?,
+            title: "20-row pile under gravity, 2 s, dt 1/15 to 1/240",
+            error: "deepest overlap at the end (radii)",
+            legend: SeriesLabelPosition::UpperLeft,
+        },
+    ];
+    for panel in &panels {
+        writeln!(out, "{}: {}", panel.title, panel.error)?;
         writeln!(
             out,
-            "{:<11} {:<11.3e} {:<31.3e} {:.3e}",
-            p.method.to_string(),
-            p.dt,
-            p.cost,
-            p.error
+            "method      dt          cost (s per sim s per critter)  error (radii)"
         )?;
+        for p in &panel.points {
+            writeln!(
+                out,
+                "{:<11} {:<11.3e} {:<31.3e} {:.3e}",
+                p.method.to_string(),
+                p.dt,
+                p.cost,
+                p.error
+            )?;
+        }
     }
     let svg = args.out.with_extension("svg");
     let png = args.out.with_extension("png");
@@ -62,13 +99,13 @@ pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, font)
         .map_err(|_| anyhow::anyhow!("{}: not a usable TrueType font", args.font.display()))?;
     draw(
-        SVGBackend::new(&svg, (900, 600)).into_drawing_area(),
-        &points,
+        SVGBackend::new(&svg, (1600, 600)).into_drawing_area(),
+        &panels,
     )
     .map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
     draw(
-        BitMapBackend::new(&png, (900, 600)).into_drawing_area(),
-        &points,
+        BitMapBackend::new(&png, (1600, 600)).into_drawing_area(),
+        &panels,
     )
     .map_err(|e| anyhow::anyhow!("{}: {e}", png.display()))?;
     writeln!(out, "wrote {} and {}", svg.display(), png.display())?;
@@ -77,13 +114,29 @@ pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
-    points: &[ChartPoint],
+    panels: &[Panel],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly((1, panels.len()));
+    for (area, panel) in areas.iter().zip(panels) {
+        draw_panel(area, panel)?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
 ) -> Result<(), Box<dyn std::error::Error>>
 where
     DB::ErrorType: 'static,
 {
     const FLOOR: f64 = 1e-16; // errors below this are drawn at it (exact to round-off)
-    root.fill(&WHITE)?;
+    let points = &panel.points;
     let err = |p: &ChartPoint| p.error.max(FLOOR);
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in points {
@@ -92,9 +145,9 @@ where
         y0 = y0.min(p.cost);
         y1 = y1.max(p.cost);
     }
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(area)
         .caption(
-            "critterbox: cost against error (100-disk gas, 1 s, dt 1/15 to 1/960)",
+            format!("critterbox: cost against error ({})", panel.title),
             ("sans-serif", 20),
         )
         .margin(15)
@@ -106,13 +159,13 @@ where
         )?;
     chart
         .configure_mesh()
-        .x_desc("RMS position error against the exact event-driven run (radii)")
+        .x_desc(panel.error)
         .y_desc("wall s per simulated s per critter")
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
-    for (i, m) in METHODS.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+    for (m, colour) in METHODS.iter().zip(COLOURS) {
+        let color = colour.to_rgba();
         let pts: Vec<(f64, f64)> = points
             .iter()
             .filter(|p| p.method == *m)
@@ -121,14 +174,16 @@ where
         chart
             .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
             .label(m.to_string())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+            });
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
     }
     chart
         .configure_series_labels()
+        .position(panel.legend.clone())
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()?;
-    root.present()?;
     Ok(())
 }

@@ -10,11 +10,26 @@
 //! spread-out slow critters cost the bullets' predictions, not everyone's. In a dense scene
 //! nearly every critter has something within reach, and the check would only add its cost (and
 //! wider cells), so the whole step is swept.
+//!
+//! Under gravity, critters come to rest on each other, and the discrete step lets stacks sink
+//! into themselves (the deep pile of `docs/stability.md`: 1.92 radii after 2 s). So a step under
+//! gravity is solved, `solve:8`, at about the discrete step's cost (0.036 radii there), and its
+//! islands at rest sleep, as long as no critter can tunnel: each moves less than half of what
+//! would carry it through a wall or a disk ([`tunnel_fraction`]). A pair that meets alone gets
+//! Pop's impulse from the solve, and a step with no contacts builds nothing to solve. Critters
+//! sliding down a pile move faster than the sweep threshold, which guards the angles of glancing
+//! hits; the solve's angles are the discrete step's, and it is the stack that matters there.
+//! Without gravity nothing rests, and `solve:n` would spread a Newton's cradle's momentum over
+//! its balls: the step stays discrete.
 
-use crate::method::swept::{count_fast, motion_scale, SWEEP_FRACTION};
+use crate::method::swept::{count_fast, displacement, motion_scale, SWEEP_FRACTION};
 use crate::method::Method;
 use crate::vector::Vector;
 use crate::world::World;
+
+/// The sweeps of the `solve:n` step `auto` takes under gravity (the stability table's
+/// `solve:8`).
+pub const AUTO_SWEEPS: u32 = 8;
 
 /// Below this packing fraction (disk area, or sphere volume, over the box's) a swept step is
 /// taken per critter.
@@ -44,11 +59,49 @@ pub struct Choice {
     pub why: String,
 }
 
+/// Below this [`tunnel_fraction`] a step under gravity is solved.
+pub const SOLVE_FRACTION: f64 = 0.5;
+
+/// The largest fraction, over the critters, of what would carry a critter through something in
+/// the coming step: its centre must pass a wall's mid-plane (its radius plus half the thinnest
+/// wall), or another disk's centre (the two radii). Each critter is measured against its radius
+/// plus the smaller of half the thinnest wall and the smallest radius, so that two critters
+/// under half their own bounds together move less than their two radii. 0 with nothing moving.
+pub fn tunnel_fraction<V: Vector>(world: &World<V>) -> f64 {
+    let (mut thinnest, mut smallest) = (f64::INFINITY, f64::INFINITY);
+    for c in world.critters.iter().filter(|c| c.alive) {
+        match c.wall() {
+            Some(w) => {
+                for axis in 0..V::DIM {
+                    thinnest = thinnest.min(2.0 * w.half.get(axis));
+                }
+            }
+            None => smallest = smallest.min(c.radius),
+        }
+    }
+    let spare = (0.5 * thinnest).min(smallest);
+    let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
+    disks
+        .map(|c| displacement(world, c) / (c.radius + spare))
+        .fold(0.0, f64::max)
+}
+
 /// The method for the coming step and why.
 pub fn choose<V: Vector>(world: &World<V>) -> Choice {
     let (fastest, smallest) = motion_scale(world);
     let limit = SWEEP_FRACTION * smallest;
-    if fastest <= limit {
+    let falling = world.gravity() != V::zero();
+    let tunnel = if falling { tunnel_fraction(world) } else { 1.0 };
+    if falling && tunnel <= SOLVE_FRACTION {
+        Choice {
+            method: Method::Solve(AUTO_SWEEPS),
+            per_critter: false,
+            why: format!(
+                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; no critter moves more than {tunnel:.3e} of what would carry it through a wall or a disk (under {SOLVE_FRACTION}); {} asleep",
+                world.sleepers()
+            ),
+        }
+    } else if fastest <= limit {
         Choice {
             method: Method::Discrete,
             per_critter: false,

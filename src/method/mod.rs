@@ -9,8 +9,9 @@
 //! * [`Method::Solve`]: the discrete step with its contacts solved together ([`solve`]): `n`
 //!   sweeps of sequential impulses over every contact, then a partial position correction, so
 //!   piles and stacks come to rest; under gravity, islands at rest then sleep ([`sleep`]).
-//! * [`Method::Auto`]: discrete or swept per step from the scene's speeds, and within a swept
-//!   step predictions only for the critters that are fast or may meet something ([`auto`]).
+//! * [`Method::Auto`]: discrete, swept or `solve:8` per step from the scene's speeds and gravity,
+//!   and within a swept step predictions only for the critters that are fast or may meet
+//!   something ([`auto`]).
 //!
 //! Every method keeps Pop's roles: a touching pair is handed to the caller's `collide` hook.
 //! [`flight`] is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact

@@ -20,7 +20,7 @@ use crate::world::{StepStats, World};
 pub const SWEEP_FRACTION: f64 = 0.25;
 
 /// How far disk `c` moves in the coming step (the free ones after gravity's kick).
-fn displacement<V: Vector>(world: &World<V>, c: &crate::critter::Critter<V>) -> f64 {
+pub(crate) fn displacement<V: Vector>(world: &World<V>, c: &crate::critter::Critter<V>) -> f64 {
     let (g, dt) = (world.gravity, world.dt);
     let v = if c.fixed { c.vel } else { c.vel + g * dt };
     v.length() * dt
