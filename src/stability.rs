@@ -439,7 +439,56 @@ pub const STRESS_3D: &[Stress] = &[
             "worst angle error of the outgoing velocities, or part out of the plane of impact (rad)",
         run: glancing_3d,
     },
+    Stress {
+        name: "deep pile (3D, 12 layers)",
+        error: "deepest overlap after 2 s, in radii (inf for NaN)",
+        run: deep_pile_3d,
+    },
 ];
+
+/// Layers of the 3D deep pile (150 spheres).
+pub const DEEP_PILE_LAYERS_3D: usize = 12;
+
+/// The deep pile in 3D: [`DEEP_PILE_LAYERS_3D`] layers of spheres of radius 0.5 (restitution 0.5)
+/// in a walled 4 x 4 well under gravity, each layer in the hollows of the one below (4 x 4 and
+/// 3 x 3 alternately, a hair apart: body-centred stacking, centres 0.707 apart in height), so
+/// the bottom spheres carry eleven layers' weight. The deepest overlap after two seconds.
+fn deep_pile_3d(method: Method) -> Result<f64, Error> {
+    let mut w = World::new(
+        WorldConfig::new(DVec3::splat(-1.0), DVec3::new(5.0, 20.0, 5.0))
+            .dt(DT)
+            .gravity(DVec3::new(0.0, -9.81, 0.0))
+            .method(method),
+    )?;
+    let (t, h) = (0.2, 15.0);
+    for (lo, hi) in [
+        (DVec3::new(-t, -t, -t), DVec3::new(4.0 + t, 0.0, 4.0 + t)),
+        (DVec3::new(-t, 0.0, -t), DVec3::new(0.0, h, 4.0 + t)),
+        (DVec3::new(4.0, 0.0, -t), DVec3::new(4.0 + t, h, 4.0 + t)),
+        (DVec3::new(0.0, 0.0, -t), DVec3::new(4.0, h, 0.0)),
+        (DVec3::new(0.0, 0.0, 4.0), DVec3::new(4.0, h, 4.0 + t)),
+    ] {
+        w.add_wall(WallBox::aligned(lo, hi)?)?;
+    }
+    let gap = 1e-6;
+    let rise = std::f64::consts::FRAC_1_SQRT_2 + gap;
+    for layer in 0..DEEP_PILE_LAYERS_3D {
+        let (count, start) = if layer % 2 == 0 { (4, 0.5) } else { (3, 1.0) };
+        let y = 0.5 + gap + layer as f64 * rise;
+        for i in 0..count {
+            for k in 0..count {
+                let (x, z) = (start + i as f64, start + k as f64);
+                w.spawn(
+                    CritterSpec::ball(DVec3::new(x, y, z))
+                        .radius(0.5)
+                        .restitution(0.5),
+                )?;
+            }
+        }
+    }
+    w.run(120)?;
+    Ok(max_overlap(&w))
+}
 
 fn world3(max: DVec3, method: Method) -> Result<World<DVec3>, Error> {
     World::new(WorldConfig::new(DVec3::ZERO, max).dt(DT).method(method))

@@ -297,6 +297,9 @@ fn stress_scenes_in_3d_meet_their_documented_bounds() {
         }
     };
     for s in STRESS_3D {
+        if s.name.starts_with("deep pile") {
+            continue; // long under event and swept: see the test below
+        }
         for m in ALL {
             let e = (s.run)(m).unwrap();
             assert!(e <= bound(s.name, m), "{} under {m}: {e}", s.name);
@@ -311,6 +314,23 @@ fn stress_scenes_in_3d_meet_their_documented_bounds() {
     assert!(discrete("dense pack 0.5 (3D)") > 0.01);
     assert!(discrete("spawned on top (3D)") > 0.01);
     assert!(discrete("glancing hits (3D)") > 0.1);
+}
+
+/// The 3D deep pile's row of `docs/stability.md`: the discrete step lets 12 layers of spheres
+/// sink more than a radius into each other within 2 s; `solve:8`, and `auto` (which solves
+/// under gravity), hold the overlap under a twentieth of a radius.
+#[test]
+fn the_discrete_step_sinks_in_a_deep_3d_pile_and_solve_holds_it() {
+    let deep = STRESS_3D
+        .iter()
+        .find(|s| s.name.starts_with("deep pile"))
+        .expect("the 3D deep pile is a stress scene");
+    let discrete = (deep.run)(Method::Discrete).unwrap();
+    assert!(discrete > 1.0, "discrete: {discrete}");
+    for m in [Method::Solve(8), Method::Auto] {
+        let e = (deep.run)(m).unwrap();
+        assert!(e < 0.05, "{m}: {e}");
+    }
 }
 
 #[test]
