@@ -11,7 +11,8 @@
 //!   9-layer pile dropped, settled and stepped under `solve:8`, its contacts solved together:
 //!   settled, it sleeps, as it would in Box2D or Rapier; `pile_9_layers_solve_8_awake` is the
 //!   same with sleep off, every contact solved every step; `pile_90_layers_solve_8` the deep
-//!   pile under `solve:8`).
+//!   pile under `solve:8`, which never comes to rest; `pile_90_layers_solve_32` the deep pile
+//!   under `solve:32`, settled for 1,800 steps: 32 sweeps carry 90 layers' weight, and it sleeps).
 //!
 //! `cargo bench --bench stress`; `docs/performance.md` has the figures. The target is each
 //! scene within 3x of the uniform gas per critter.
@@ -104,11 +105,12 @@ fn radii_x100_with(mode: BroadPhaseMode) -> World<DVec2> {
 /// Disks of radius 0.5 on a loose grid (spacing 1.5) in a box `w` wide, dropped under gravity
 /// with restitution 0.5 and settled for 900 steps.
 fn pile(w: f64) -> World<DVec2> {
-    pile_under(w, Method::Discrete, false)
+    pile_under(w, Method::Discrete, false, 900)
 }
 
-/// [`pile`], dropped, settled and stepped under `method`, with sleep on or off.
-fn pile_under(w: f64, method: Method, sleep: bool) -> World<DVec2> {
+/// [`pile`], dropped, settled for `settle` steps and stepped under `method`, with sleep on or
+/// off.
+fn pile_under(w: f64, method: Method, sleep: bool, settle: u64) -> World<DVec2> {
     let spacing = 1.5;
     let per_row = (w / spacing) as usize;
     let rows = N.div_ceil(per_row);
@@ -127,7 +129,7 @@ fn pile_under(w: f64, method: Method, sleep: bool) -> World<DVec2> {
             .spawn(CritterSpec::ball(pos).vel(vel).radius(0.5).restitution(0.5))
             .expect("a disk");
     }
-    world.run(900).expect("the pile settles");
+    world.run(settle).expect("the pile settles");
     world
 }
 
@@ -143,13 +145,16 @@ fn stress(c: &mut Criterion) {
         ("pile_9_layers", || pile(1000.0)),
         ("pile_90_layers", || pile(100.0)),
         ("pile_9_layers_solve_8", || {
-            pile_under(1000.0, Method::Solve(8), true)
+            pile_under(1000.0, Method::Solve(8), true, 900)
         }),
         ("pile_9_layers_solve_8_awake", || {
-            pile_under(1000.0, Method::Solve(8), false)
+            pile_under(1000.0, Method::Solve(8), false, 900)
         }),
         ("pile_90_layers_solve_8", || {
-            pile_under(100.0, Method::Solve(8), true)
+            pile_under(100.0, Method::Solve(8), true, 900)
+        }),
+        ("pile_90_layers_solve_32", || {
+            pile_under(100.0, Method::Solve(32), true, 1800)
         }),
     ] {
         let mut world = build();
