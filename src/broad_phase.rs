@@ -820,17 +820,23 @@ fn retest<V: Vector, O: Objects<V> + ?Sized>(
     pairs: &[(u32, u32)],
     out: &mut Vec<(u32, u32)>,
 ) -> u64 {
-    if !objs.any_still() {
-        for (k, pair) in pairs.iter().enumerate() {
-            if let Some(ahead) = pairs.get(k + PAIRS_AHEAD) {
-                objs.prefetch(ahead.0 as usize);
-                objs.prefetch(ahead.1 as usize);
-            }
-            out.extend(exact(objs, topo, pair));
-        }
-        return pairs.len() as u64;
+    if objs.any_still() {
+        retest_skipping::<true, V, O>(objs, topo, pairs, out)
+    } else {
+        retest_skipping::<false, V, O>(objs, topo, pairs, out)
     }
-    let still = |&(i, j): &(u32, u32)| objs.still(i as usize) && objs.still(j as usize);
+}
+
+/// [`retest`]'s loop; with `STILL` false nothing is still, and the check is compiled away (the
+/// gas pays nothing for sleep).
+#[inline]
+fn retest_skipping<const STILL: bool, V: Vector, O: Objects<V> + ?Sized>(
+    objs: &O,
+    topo: &Topology<V>,
+    pairs: &[(u32, u32)],
+    out: &mut Vec<(u32, u32)>,
+) -> u64 {
+    let still = |&(i, j): &(u32, u32)| STILL && objs.still(i as usize) && objs.still(j as usize);
     let mut tested = 0;
     for (k, pair) in pairs.iter().enumerate() {
         if let Some(ahead) = pairs.get(k + PAIRS_AHEAD) {

@@ -701,25 +701,8 @@ fn chart_gas(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
 /// ([`DEEP_PILE_ROWS`] rows under gravity) for two simulated seconds at dt = 1/15 ... 1/240, the
 /// error being the deepest overlap at the end in radii (the stability table's measure).
 pub fn chart_pile_points(methods: &[Method]) -> Result<Vec<ChartPoint>, Error> {
-    let mut out = Vec::new();
-    for &method in methods {
-        for k in 0..5 {
-            let dt = 1.0 / (15.0 * 2f64.powi(k));
-            let mut w = pile(method, DEEP_PILE_ROWS, dt)?;
-            let steps = (2.0 / dt).round() as u64;
-            let n = w.critters().iter().filter(|c| !c.is_wall()).count() as f64;
-            let start = std::time::Instant::now();
-            w.run(steps)?;
-            let cost = start.elapsed().as_secs_f64() / n / 2.0;
-            out.push(ChartPoint {
-                method,
-                dt,
-                cost,
-                error: max_overlap(&w),
-            });
-        }
-    }
-    Ok(out)
+    let build = |method, dt| pile(method, DEEP_PILE_ROWS, dt);
+    dt_sweep(methods, 5, 2.0, build, max_overlap)
 }
 
 /// Runs the chart's sweep: each method at dt = 1/15 ... 1/960 over one simulated second, error
@@ -728,27 +711,44 @@ pub fn chart_points(methods: &[Method]) -> Result<Vec<ChartPoint>, Error> {
     let mut reference = chart_gas(Method::Event, 1.0)?;
     reference.step()?;
     let want: Vec<DVec2> = reference.critters().iter().map(|c| c.pos).collect();
+    let error = |w: &World<DVec2>| {
+        let (mut sum, mut n) = (0.0, 0.0);
+        for (c, p) in w.critters().iter().zip(&want) {
+            if !c.is_wall() {
+                sum += (c.pos - *p).length_squared() / (c.radius() * c.radius());
+                n += 1.0;
+            }
+        }
+        (sum / n).sqrt()
+    };
+    dt_sweep(methods, 7, 1.0, chart_gas, error)
+}
+
+/// Runs each method at `dts` time steps, dt = 1/15, 1/30, ..., for `seconds` simulated seconds
+/// on the scene `build` makes, and measures the cost (wall time per simulated second per
+/// critter) and `error` of the world at the end.
+fn dt_sweep(
+    methods: &[Method],
+    dts: i32,
+    seconds: f64,
+    build: impl Fn(Method, f64) -> Result<World<DVec2>, Error>,
+    error: impl Fn(&World<DVec2>) -> f64,
+) -> Result<Vec<ChartPoint>, Error> {
     let mut out = Vec::new();
     for &method in methods {
-        for k in 0..7 {
+        for k in 0..dts {
             let dt = 1.0 / (15.0 * 2f64.powi(k));
-            let mut w = chart_gas(method, dt)?;
-            let steps = (1.0 / dt).round() as u64;
+            let mut w = build(method, dt)?;
+            let steps = (seconds / dt).round() as u64;
             let n = w.critters().iter().filter(|c| !c.is_wall()).count() as f64;
             let start = std::time::Instant::now();
             w.run(steps)?;
-            let cost = start.elapsed().as_secs_f64() / n;
-            let mut sum = 0.0;
-            for (c, p) in w.critters().iter().zip(&want) {
-                if !c.is_wall() {
-                    sum += (c.pos - *p).length_squared() / (c.radius() * c.radius());
-                }
-            }
+            let cost = start.elapsed().as_secs_f64() / n / seconds;
             out.push(ChartPoint {
                 method,
                 dt,
                 cost,
-                error: (sum / n).sqrt(),
+                error: error(&w),
             });
         }
     }

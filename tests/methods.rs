@@ -2,7 +2,7 @@
 //! event-driven flights, the stability boundaries of docs/stability.md, determinism.
 
 use critterbox::scenes::{gas, GasParams};
-use critterbox::stability::{bullet, bullet_3d, bullet_speeds, STRESS, STRESS_3D};
+use critterbox::stability::{bullet, bullet_3d, bullet_speeds, Stress, STRESS, STRESS_3D};
 use critterbox::{Border, CritterSpec, Method, WallBox, World, WorldConfig};
 use glam::{DVec2, DVec3};
 
@@ -281,6 +281,12 @@ fn in_3d_too_discrete_tunnels_past_its_stated_speed_and_swept_and_event_never_do
     }
 }
 
+/// The stress scene of `list` whose name starts with `prefix`.
+fn stress<'a>(list: &'a [Stress], prefix: &str) -> &'a Stress {
+    let found = list.iter().find(|s| s.name.starts_with(prefix));
+    found.unwrap_or_else(|| panic!("no stress scene starts with {prefix:?}"))
+}
+
 #[test]
 fn stress_scenes_in_3d_meet_their_documented_bounds() {
     // The laws the scenes measure: equal elastic spheres in a line hand all momentum on;
@@ -307,10 +313,7 @@ fn stress_scenes_in_3d_meet_their_documented_bounds() {
     }
     // The failures the table documents: discrete overlaps in the dense pack, leaves stacked
     // spawns overlapping after 30 steps and sends glancing spheres off a quarter radian wrong.
-    let discrete = |name: &str| {
-        let s = STRESS_3D.iter().find(|s| s.name == name).unwrap();
-        (s.run)(Method::Discrete).unwrap()
-    };
+    let discrete = |name: &str| (stress(STRESS_3D, name).run)(Method::Discrete).unwrap();
     assert!(discrete("dense pack 0.5 (3D)") > 0.01);
     assert!(discrete("spawned on top (3D)") > 0.01);
     assert!(discrete("glancing hits (3D)") > 0.1);
@@ -321,10 +324,7 @@ fn stress_scenes_in_3d_meet_their_documented_bounds() {
 /// under gravity), hold the overlap under a twentieth of a radius.
 #[test]
 fn the_discrete_step_sinks_in_a_deep_3d_pile_and_solve_holds_it() {
-    let deep = STRESS_3D
-        .iter()
-        .find(|s| s.name.starts_with("deep pile"))
-        .expect("the 3D deep pile is a stress scene");
+    let deep = stress(STRESS_3D, "deep pile");
     let discrete = (deep.run)(Method::Discrete).unwrap();
     assert!(discrete > 1.0, "discrete: {discrete}");
     for m in [Method::Solve(8), Method::Auto] {
@@ -356,18 +356,16 @@ fn stress_scenes_meet_their_documented_bounds() {
     }
     // And the failures the table documents: discrete overlaps in the dense pack and leaves
     // stacked spawns overlapping after 30 steps.
-    assert!((STRESS[3].run)(Method::Discrete).unwrap() > 0.01);
-    assert!((STRESS[4].run)(Method::Discrete).unwrap() > 0.01);
+    let discrete = |name: &str| (stress(STRESS, name).run)(Method::Discrete).unwrap();
+    assert!(discrete("dense pack") > 0.01);
+    assert!(discrete("spawned on top") > 0.01);
 }
 
 /// The deep pile's row of `docs/stability.md`: the discrete step lets the 20-row pile sink more
 /// than a radius into itself within 2 s; 8 substeps keep it under half a radius.
 #[test]
 fn the_discrete_step_sinks_in_a_deep_pile_and_substeps_reduce_it() {
-    let deep = STRESS
-        .iter()
-        .find(|s| s.name.starts_with("deep pile"))
-        .expect("the deep pile is a stress scene");
+    let deep = stress(STRESS, "deep pile");
     let discrete = (deep.run)(Method::Discrete).unwrap();
     let substep = (deep.run)(Method::Substep(8)).unwrap();
     assert!(discrete > 1.0, "discrete: {discrete}");
@@ -636,10 +634,7 @@ fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::Cri
 fn auto_solves_resting_piles_under_gravity_but_sweeps_a_bullet_and_never_solves_without_it() {
     // The deep pile of the stability table: discrete sinks more than a radius (asserted above);
     // auto holds it to a tenth of a radius, as solve:8 does.
-    let deep = STRESS
-        .iter()
-        .find(|s| s.name.starts_with("deep pile"))
-        .expect("the deep pile is a stress scene");
+    let deep = stress(STRESS, "deep pile");
     let auto = (deep.run)(Method::Auto).unwrap();
     assert!(auto < 0.1, "auto: deepest overlap {auto} radii");
 

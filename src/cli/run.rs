@@ -169,9 +169,8 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if let Some((chose, why)) = scene.world.auto_choice() {
         writeln!(out, "auto chose   {chose} (last step): {why}")?;
     }
-    let solved =
-        |m: Option<crate::method::Method>| matches!(m, Some(crate::method::Method::Solve(_)));
-    if solved(Some(method)) || solved(scene.world.auto_choice().map(|c| c.0)) {
+    let stepped = scene.world.auto_choice().map_or(method, |c| c.0);
+    if matches!(stepped, crate::method::Method::Solve(_)) {
         let how = if scene.world.sleep_allowed() {
             "critters at rest under gravity sleep; `sleep: false` in world(#{ ... }) turns it off"
         } else {

@@ -22,7 +22,7 @@
 //! Without gravity nothing rests, and `solve:n` would spread a Newton's cradle's momentum over
 //! its balls: the step stays discrete.
 
-use crate::method::swept::{count_fast, displacement, motion_scale, SWEEP_FRACTION};
+use crate::method::swept::{count_fast, displacement, motion_scale, MotionScale, SWEEP_FRACTION};
 use crate::method::Method;
 use crate::vector::Vector;
 use crate::world::World;
@@ -67,19 +67,9 @@ pub const SOLVE_FRACTION: f64 = 0.5;
 /// wall), or another disk's centre (the two radii). Each critter is measured against its radius
 /// plus the smaller of half the thinnest wall and the smallest radius, so that two critters
 /// under half their own bounds together move less than their two radii. 0 with nothing moving.
-pub fn tunnel_fraction<V: Vector>(world: &World<V>) -> f64 {
-    let (mut thinnest, mut smallest) = (f64::INFINITY, f64::INFINITY);
-    for c in world.critters.iter().filter(|c| c.alive) {
-        match c.wall() {
-            Some(w) => {
-                for axis in 0..V::DIM {
-                    thinnest = thinnest.min(2.0 * w.half.get(axis));
-                }
-            }
-            None => smallest = smallest.min(c.radius),
-        }
-    }
-    let spare = (0.5 * thinnest).min(smallest);
+/// `scale` is the world's [`motion_scale`].
+pub fn tunnel_fraction<V: Vector>(world: &World<V>, scale: &MotionScale) -> f64 {
+    let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
     let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
     disks
         .map(|c| displacement(world, c) / (c.radius + spare))
@@ -88,10 +78,15 @@ pub fn tunnel_fraction<V: Vector>(world: &World<V>) -> f64 {
 
 /// The method for the coming step and why.
 pub fn choose<V: Vector>(world: &World<V>) -> Choice {
-    let (fastest, smallest) = motion_scale(world);
+    let scale = motion_scale(world);
+    let (fastest, smallest) = (scale.fastest, scale.smallest());
     let limit = SWEEP_FRACTION * smallest;
     let falling = world.gravity() != V::zero();
-    let tunnel = if falling { tunnel_fraction(world) } else { 1.0 };
+    let tunnel = if falling {
+        tunnel_fraction(world, &scale)
+    } else {
+        1.0
+    };
     if falling && tunnel <= SOLVE_FRACTION {
         Choice {
             method: Method::Solve(AUTO_SWEEPS),

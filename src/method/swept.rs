@@ -26,25 +26,47 @@ pub(crate) fn displacement<V: Vector>(world: &World<V>, c: &crate::critter::Crit
     v.length() * dt
 }
 
-/// The largest displacement of a critter in the coming step, and the smallest length it must be
-/// compared with (smallest disk radius, thinnest wall).
-pub fn motion_scale<V: Vector>(world: &World<V>) -> (f64, f64) {
-    let mut fastest: f64 = 0.0;
-    let mut smallest = f64::INFINITY;
+/// The scales a step's motion is measured against, from one pass over the critters.
+#[derive(Clone, Copy, Debug)]
+pub struct MotionScale {
+    /// The largest displacement of a disk in the coming step.
+    pub fastest: f64,
+    /// The thinnest wall (its smallest extent), or infinity with no walls.
+    pub thinnest_wall: f64,
+    /// The smallest disk radius, or infinity with no disks.
+    pub smallest_radius: f64,
+}
+
+impl MotionScale {
+    /// The smallest length a displacement is compared with: the smallest radius or the thinnest
+    /// wall.
+    pub fn smallest(&self) -> f64 {
+        self.thinnest_wall.min(self.smallest_radius)
+    }
+}
+
+/// The largest displacement of a critter in the coming step, and the lengths it must be compared
+/// with (smallest disk radius, thinnest wall).
+pub fn motion_scale<V: Vector>(world: &World<V>) -> MotionScale {
+    let mut scale = MotionScale {
+        fastest: 0.0,
+        thinnest_wall: f64::INFINITY,
+        smallest_radius: f64::INFINITY,
+    };
     for c in world.critters.iter().filter(|c| c.alive) {
         match c.wall() {
             Some(w) => {
                 for axis in 0..V::DIM {
-                    smallest = smallest.min(2.0 * w.half.get(axis));
+                    scale.thinnest_wall = scale.thinnest_wall.min(2.0 * w.half.get(axis));
                 }
             }
             None => {
-                smallest = smallest.min(c.radius);
-                fastest = fastest.max(displacement(world, c));
+                scale.smallest_radius = scale.smallest_radius.min(c.radius);
+                scale.fastest = scale.fastest.max(displacement(world, c));
             }
         }
     }
-    (fastest, smallest)
+    scale
 }
 
 /// How many live disks move more than `limit` in the coming step, and how many there are.
@@ -80,9 +102,9 @@ fn sweep<V: Vector>(
     stats: &mut StepStats,
     fast_only: bool,
 ) -> Result<(), Error> {
-    let (fastest, smallest) = motion_scale(world);
-    let limit = SWEEP_FRACTION * smallest;
-    if fastest <= limit {
+    let scale = motion_scale(world);
+    let limit = SWEEP_FRACTION * scale.smallest();
+    if scale.fastest <= limit {
         return world.discrete_substeps(1, stats);
     }
     let clock = std::time::Instant::now();
