@@ -891,10 +891,12 @@ impl<V: Vector> World<V> {
         self.stage_update()?;
         stats.update = clock.elapsed();
         let mut per_critter = false;
+        let mut substeps = 1;
         let method = match self.method {
             Method::Auto => {
                 let choice = crate::method::auto::choose(self);
                 per_critter = choice.per_critter;
+                substeps = choice.substeps;
                 self.auto_choice = Some((choice.method, choice.why));
                 choice.method
             }
@@ -919,10 +921,13 @@ impl<V: Vector> World<V> {
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
             Method::Solve(n) => {
-                let clock = Instant::now();
-                self.stage_move(self.dt);
-                stats.moving += clock.elapsed();
-                self.collide_stages(Some(n), &mut stats)?;
+                let h = self.dt / f64::from(substeps);
+                for _ in 0..substeps {
+                    let clock = Instant::now();
+                    self.stage_move(h);
+                    stats.moving += clock.elapsed();
+                    self.collide_stages(Some((n, h)), &mut stats)?;
+                }
             }
         }
         let clock = Instant::now();
@@ -960,8 +965,13 @@ impl<V: Vector> World<V> {
     }
 
     /// Broad phase, rules, narrow phase and response where the critters are now: Pop's response
-    /// pair by pair, or with `Some(n)` the contacts solved together in `n` sweeps.
-    fn collide_stages(&mut self, sweeps: Option<u32>, stats: &mut StepStats) -> Result<(), Error> {
+    /// pair by pair, or with `Some((n, h))` the contacts solved together in `n` sweeps after a
+    /// move of `h`.
+    fn collide_stages(
+        &mut self,
+        solve: Option<(u32, f64)>,
+        stats: &mut StepStats,
+    ) -> Result<(), Error> {
         let mut clock = Instant::now();
         let mut lap = |slot: &mut Duration| {
             let now = Instant::now();
@@ -988,8 +998,8 @@ impl<V: Vector> World<V> {
         };
         self.sort_contacts();
         lap(&mut stats.narrow_phase);
-        let collisions = match sweeps {
-            Some(n) => self.stage_solve(n)?,
+        let collisions = match solve {
+            Some((n, h)) => self.stage_solve(n, h)?,
             None => self.stage_response()?,
         };
         lap(&mut stats.response);

@@ -626,6 +626,69 @@ fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::Cri
     (w, bullet)
 }
 
+/// A heap of 180 balls (radius 0.5, e 0.5) dropped from 60 to 90 units into a box with a
+/// 0.02-thick floor and walls, stepped for 6 s under `method`; the number of steps `auto` cut
+/// into substeps (0 under other methods).
+fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
+    let mut w = World::new(
+        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(12.0, 100.0))
+            .gravity(DVec2::new(0.0, -9.81))
+            .method(method),
+    )
+    .unwrap();
+    let t = 0.02;
+    for (lo, hi) in [
+        (DVec2::new(-t, -t), DVec2::new(10.0 + t, 0.0)),
+        (DVec2::new(-t, 0.0), DVec2::new(0.0, 98.0)),
+        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, 98.0)),
+    ] {
+        w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
+    }
+    for row in 0..20 {
+        for k in 0..9 {
+            let pos = DVec2::new(1.0 + k as f64, 60.0 + 1.5 * row as f64);
+            w.spawn(CritterSpec::ball(pos).radius(0.5).restitution(0.5))
+                .unwrap();
+        }
+    }
+    let mut substeps = 0;
+    for _ in 0..360 {
+        w.step().unwrap();
+        let why = w.auto_choice().map_or("", |c| c.1.as_str());
+        substeps += usize::from(why.contains("substeps"));
+    }
+    (w, substeps)
+}
+
+/// `auto` cuts a solved step into substeps when critters fall fast (`src/method/auto.rs`): the
+/// dropped heap's balls reach 34 to 42 units per second, 0.57 to 0.7 per step, more than what
+/// carries a ball's centre past the floor's mid-plane (its radius and half the floor, 0.51).
+/// Fixed `solve:8` lets a ball through the floor; each of auto's substeps moves a ball less than
+/// half that, so every ball stays in, and the heap is solved as it lands.
+#[test]
+fn auto_cuts_a_fast_falling_heap_into_solved_substeps_and_keeps_every_ball_in() {
+    let inside = |w: &World<DVec2>| {
+        let balls = w.critters().iter().filter(|c| !c.is_wall());
+        balls
+            .filter(|b| b.pos.x > 0.0 && b.pos.x < 10.0 && b.pos.y > 0.0)
+            .count()
+    };
+    let (w, _) = dropped_heap(Method::Solve(8));
+    assert!(inside(&w) < 180, "solve:8 kept every ball in");
+
+    let (w, substeps) = dropped_heap(Method::Auto);
+    assert!(substeps > 0, "auto never cut a step into substeps");
+    assert_eq!(inside(&w), 180, "auto let a ball out");
+    let balls: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
+    let mut deepest: f64 = 0.0;
+    for (i, a) in balls.iter().enumerate() {
+        for b in &balls[i + 1..] {
+            deepest = deepest.max((1.0 - a.pos.distance(b.pos)) / 0.5);
+        }
+    }
+    assert!(deepest < 0.2, "deepest overlap {deepest} radii");
+}
+
 /// `auto` solves under gravity (`src/method/auto.rs`): a pile is solved by `solve:8` and falls
 /// asleep, where the discrete step would let a deep pile sink
 /// (`docs/stability.md`); without gravity it never solves; and a critter fast enough to tunnel

@@ -14,9 +14,12 @@
 //! Under gravity, critters come to rest on each other, and the discrete step lets stacks sink
 //! into themselves (the deep pile of `docs/stability.md`: 1.92 radii after 2 s). So a step under
 //! gravity is solved, `solve:8`, at about the discrete step's cost (0.036 radii there), and its
-//! islands at rest sleep, as long as no critter can tunnel: each moves less than half of what
-//! would carry it through a wall or a disk ([`tunnel_fraction`]). A pair that meets alone gets
-//! Pop's impulse from the solve, and a step with no contacts builds nothing to solve. Critters
+//! islands at rest sleep. So that no critter can tunnel, the solved step is cut into as many
+//! substeps as keep each critter under half of what would carry it through a wall or a disk in
+//! one substep ([`tunnel_fraction`]), up to [`MOST_SOLVE_SUBSTEPS`]; a step that would need more
+//! is swept. A heap falling fast is then solved as it lands: swept, a dense heap runs out of the
+//! swept step's event budget and its discrete pass pushes balls through the floor. A pair that
+//! meets alone gets Pop's impulse from the solve, and a step with no contacts builds nothing to solve. Critters
 //! sliding down a pile move faster than the sweep threshold, which guards the angles of glancing
 //! hits; the solve's angles are the discrete step's, and it is the stack that matters there.
 //! Without gravity nothing rests, and `solve:n` would spread a Newton's cradle's momentum over
@@ -55,12 +58,18 @@ pub struct Choice {
     pub method: Method,
     /// A swept step taken per critter (a sparse scene).
     pub per_critter: bool,
+    /// Substeps of a solved step (1 otherwise).
+    pub substeps: u32,
     /// Why, for `critterbox run`.
     pub why: String,
 }
 
-/// Below this [`tunnel_fraction`] a step under gravity is solved.
+/// A step under gravity is solved in as many substeps as keep each substep's
+/// [`tunnel_fraction`] under this.
 pub const SOLVE_FRACTION: f64 = 0.5;
+
+/// The most substeps of a solved step; a step that would need more is swept.
+pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 
 /// The largest fraction, over the critters, of what would carry a critter through something in
 /// the coming step: its centre must pass a wall's mid-plane (its radius plus half the thinnest
@@ -87,12 +96,19 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
     } else {
         1.0
     };
-    if falling && tunnel <= SOLVE_FRACTION {
+    if falling && tunnel <= SOLVE_FRACTION * f64::from(MOST_SOLVE_SUBSTEPS) {
+        // Integer-valued and from 1 to MOST_SOLVE_SUBSTEPS: the cast is exact.
+        let substeps = (tunnel / SOLVE_FRACTION).ceil().max(1.0) as u32;
+        let how = match substeps {
+            1 => format!("no critter moves more than {tunnel:.3e} of what would carry it through a wall or a disk (under {SOLVE_FRACTION})"),
+            k => format!("the fastest critter moves {tunnel:.3e} of what would carry it through a wall or a disk, so the step is cut into {k} substeps of under {SOLVE_FRACTION} each"),
+        };
         Choice {
             method: Method::Solve(AUTO_SWEEPS),
             per_critter: false,
+            substeps,
             why: format!(
-                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; no critter moves more than {tunnel:.3e} of what would carry it through a wall or a disk (under {SOLVE_FRACTION}); {} asleep",
+                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; {how}; {} asleep",
                 world.sleepers()
             ),
         }
@@ -100,6 +116,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
         Choice {
             method: Method::Discrete,
             per_critter: false,
+            substeps: 1,
             why: format!(
                 "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
             ),
@@ -116,6 +133,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
         Choice {
             method: Method::Swept,
             per_critter,
+            substeps: 1,
             why: format!(
                 "swept: the fastest critter moves {fastest:.3e} per step, more than {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete could tunnel; {fast} of {all} critters move that far; {slow}"
             ),

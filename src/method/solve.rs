@@ -136,16 +136,16 @@ impl<V> Default for Scratch<V> {
 }
 
 impl<V: Vector> World<V> {
-    /// The response stage of `solve:n`: hooks first, then the rest solved together. Returns how
-    /// many pairs were handled.
-    pub(crate) fn stage_solve(&mut self, sweeps: u32) -> Result<usize, Error> {
+    /// The response stage of `solve:n`: hooks first, then the rest solved together, after a move
+    /// of `h` (the step, or under `auto` a substep of it). Returns how many pairs were handled.
+    pub(crate) fn stage_solve(&mut self, sweeps: u32, h: f64) -> Result<usize, Error> {
         let mut scratch = std::mem::take(&mut self.solve);
-        let result = self.solve_with(&mut scratch, sweeps);
+        let result = self.solve_with(&mut scratch, sweeps, h);
         self.solve = scratch;
         result
     }
 
-    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: u32) -> Result<usize, Error> {
+    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: u32, h: f64) -> Result<usize, Error> {
         let mut handled = 0;
         // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
         s.plain.clear();
@@ -199,7 +199,7 @@ impl<V: Vector> World<V> {
         }
         s.shift.clear();
         s.shift.extend(s.bodies.iter().map(|body| body.vel));
-        let resting = RESTING_STEPS * self.gravity.length() * self.dt;
+        let resting = RESTING_STEPS * self.gravity.length() * h;
         s.rows.clear();
         s.rests.clear();
         s.keys.clear();
@@ -292,7 +292,7 @@ impl<V: Vector> World<V> {
         // by the solved one (x + v' dt, semi-implicit Euler with the impulses in v'): a ball
         // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
         // before the solve.
-        let dt = self.dt;
+        let dt = h;
         for (shift, body) in s.shift.iter_mut().zip(&s.bodies) {
             *shift = (body.vel - *shift) * dt;
         }
