@@ -586,24 +586,31 @@ fn a_disk_grown_by_its_hook_is_met_by_every_method_that_never_misses() {
     }
 }
 
-/// A walled box 10 wide with a floor and side walls 0.2 thick under gravity, three rows of balls
-/// of radius 0.5 resting on the floor, and a bullet of radius 0.05 flying at `speed` towards
-/// the right wall, well above the pile (the world's edge is far beyond that wall). Returns the world and the bullet's id.
-fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::CritterId) {
+/// A world from (-1, -1) to `top` under gravity, with a floor of thickness `t` from x = 0 to 10
+/// at y = 0 and side walls up to `height`.
+fn well(method: Method, top: DVec2, height: f64, t: f64) -> World<DVec2> {
     let mut w = World::new(
-        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(30.0, 30.0))
+        WorldConfig::new(DVec2::new(-1.0, -1.0), top)
             .gravity(DVec2::new(0.0, -9.81))
             .method(method),
     )
     .unwrap();
-    let t = 0.2;
     for (lo, hi) in [
         (DVec2::new(-t, -t), DVec2::new(10.0 + t, 0.0)),
-        (DVec2::new(-t, 0.0), DVec2::new(0.0, 25.0)),
-        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, 25.0)),
+        (DVec2::new(-t, 0.0), DVec2::new(0.0, height)),
+        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, height)),
     ] {
         w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
     }
+    w
+}
+
+/// A walled box 10 wide with a floor and side walls 0.2 thick under gravity, three rows of balls
+/// of radius 0.5 resting on the floor, and a bullet of radius 0.05 flying at `speed` towards
+/// the right wall, well above the pile (the world's edge is far beyond that wall). Returns the
+/// world and the bullet's id.
+fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::CritterId) {
+    let mut w = well(method, DVec2::new(30.0, 30.0), 25.0, 0.2);
     for row in 0..3 {
         for k in 0..8 {
             let x = 1.0 + k as f64 * 1.000_001 + if row % 2 == 1 { 0.5 } else { 0.0 };
@@ -630,20 +637,7 @@ fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::Cri
 /// 0.02-thick floor and walls, stepped for 6 s under `method`; the number of steps `auto` cut
 /// into substeps (0 under other methods).
 fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
-    let mut w = World::new(
-        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(12.0, 100.0))
-            .gravity(DVec2::new(0.0, -9.81))
-            .method(method),
-    )
-    .unwrap();
-    let t = 0.02;
-    for (lo, hi) in [
-        (DVec2::new(-t, -t), DVec2::new(10.0 + t, 0.0)),
-        (DVec2::new(-t, 0.0), DVec2::new(0.0, 98.0)),
-        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, 98.0)),
-    ] {
-        w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
-    }
+    let mut w = well(method, DVec2::new(12.0, 100.0), 98.0, 0.02);
     for row in 0..20 {
         for k in 0..9 {
             let pos = DVec2::new(1.0 + k as f64, 60.0 + 1.5 * row as f64);
