@@ -913,22 +913,14 @@ impl<V: Vector> World<V> {
             self.sleep.clear();
         }
         match method {
-            Method::Discrete | Method::Auto => self.discrete_substeps(1, &mut stats)?,
-            Method::Substep(n) => self.discrete_substeps(n.max(1), &mut stats)?,
+            Method::Discrete | Method::Auto => self.substeps(1, None, &mut stats)?,
+            Method::Substep(n) => self.substeps(n.max(1), None, &mut stats)?,
             Method::Swept if per_critter => {
                 crate::method::swept::step_where_needed(self, &mut stats)?
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
-            Method::Solve(n) => {
-                let h = self.dt / f64::from(substeps);
-                for _ in 0..substeps {
-                    let clock = Instant::now();
-                    self.stage_move(h);
-                    stats.moving += clock.elapsed();
-                    self.collide_stages(Some((n, h)), &mut stats)?;
-                }
-            }
+            Method::Solve(n) => self.substeps(substeps, Some(n), &mut stats)?,
         }
         let clock = Instant::now();
         self.stage_lifecycle()?;
@@ -946,15 +938,21 @@ impl<V: Vector> World<V> {
         Ok(())
     }
 
-    /// Pop's step without the update hooks and lifecycle: `n` times move by dt/n, broad phase,
-    /// rules, narrow phase, response.
-    pub(crate) fn discrete_substeps(&mut self, n: u32, stats: &mut StepStats) -> Result<(), Error> {
-        let h = self.dt / n as f64;
+    /// Pop's step without the update hooks and lifecycle: `n` times move by h = dt/n, broad
+    /// phase, rules, narrow phase, and Pop's response pair by pair, or with `Some(sweeps)` the
+    /// contacts solved together in that many sweeps.
+    pub(crate) fn substeps(
+        &mut self,
+        n: u32,
+        solve: Option<u32>,
+        stats: &mut StepStats,
+    ) -> Result<(), Error> {
+        let h = self.dt / f64::from(n);
         for _ in 0..n {
             let clock = Instant::now();
             self.stage_move(h);
             stats.moving += clock.elapsed();
-            self.discrete_collide(stats)?;
+            self.collide_stages(solve.map(|sweeps| (sweeps, h)), stats)?;
         }
         Ok(())
     }

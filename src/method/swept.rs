@@ -105,7 +105,7 @@ fn sweep<V: Vector>(
     let scale = motion_scale(world);
     let limit = SWEEP_FRACTION * scale.smallest();
     if scale.fastest <= limit {
-        return world.discrete_substeps(1, stats);
+        return world.substeps(1, None, stats);
     }
     let clock = std::time::Instant::now();
     let dv = world.gravity * world.dt;
