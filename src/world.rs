@@ -192,7 +192,8 @@ pub struct StepStats {
     /// crossings).
     pub events: u64,
     /// Steps in which the swept or event method ran out of its event budget and finished the
-    /// step with a discrete pass (see `docs/methods.md`).
+    /// step in discrete substeps (swept) or with a discrete pass (event); see
+    /// `docs/stability.md`.
     pub budget_exceeded: u64,
 }
 
@@ -913,14 +914,14 @@ impl<V: Vector> World<V> {
             self.sleep.clear();
         }
         match method {
-            Method::Discrete | Method::Auto => self.substeps(1, None, &mut stats)?,
-            Method::Substep(n) => self.substeps(n.max(1), None, &mut stats)?,
+            Method::Discrete | Method::Auto => self.substeps(self.dt, 1, None, &mut stats)?,
+            Method::Substep(n) => self.substeps(self.dt, n.max(1), None, &mut stats)?,
             Method::Swept if per_critter => {
                 crate::method::swept::step_where_needed(self, &mut stats)?
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
-            Method::Solve(n) => self.substeps(substeps, Some(n), &mut stats)?,
+            Method::Solve(n) => self.substeps(self.dt, substeps, Some(n), &mut stats)?,
         }
         let clock = Instant::now();
         self.stage_lifecycle()?;
@@ -938,16 +939,18 @@ impl<V: Vector> World<V> {
         Ok(())
     }
 
-    /// Pop's step without the update hooks and lifecycle: `n` times move by h = dt/n, broad
-    /// phase, rules, narrow phase, and Pop's response pair by pair, or with `Some(sweeps)` the
-    /// contacts solved together in that many sweeps.
+    /// Pop's step over `span` (dt, or what is left of it) without the update hooks and
+    /// lifecycle: `n` times move by h = span/n, broad phase, rules, narrow phase, and Pop's
+    /// response pair by pair, or with `Some(sweeps)` the contacts solved together in that many
+    /// sweeps.
     pub(crate) fn substeps(
         &mut self,
+        span: f64,
         n: u32,
         solve: Option<u32>,
         stats: &mut StepStats,
     ) -> Result<(), Error> {
-        let h = self.dt / f64::from(n);
+        let h = span / f64::from(n);
         for _ in 0..n {
             let clock = Instant::now();
             self.stage_move(h);

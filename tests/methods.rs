@@ -2,7 +2,7 @@
 //! event-driven flights, the stability boundaries of docs/stability.md, determinism.
 
 use critterbox::scenes::{gas, GasParams};
-use critterbox::stability::{bullet, bullet_3d, bullet_speeds, Stress, STRESS, STRESS_3D};
+use critterbox::stability::{bullet, bullet_3d, bullet_speeds, Stress, METHODS, STRESS, STRESS_3D};
 use critterbox::{Border, CritterSpec, Method, WallBox, World, WorldConfig};
 use glam::{DVec2, DVec3};
 
@@ -610,9 +610,29 @@ fn well(method: Method, top: DVec2, height: f64, t: f64) -> World<DVec2> {
 /// the right wall, well above the pile (the world's edge is far beyond that wall). Returns the
 /// world and the bullet's id.
 fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::CritterId) {
-    let mut w = well(method, DVec2::new(30.0, 30.0), 25.0, 0.2);
-    for row in 0..3 {
-        for k in 0..8 {
+    bullet_over_pile(method, speed, 3, 8, 0.2, 30.0)
+}
+
+/// A walled well 10 wide, walls `t` thick and `top - 5` high, under gravity; `rows` rows of
+/// `per_row` balls of radius 0.5 (at most 8 in the odd rows, which sit in the hollows), a hair
+/// apart, resting on its floor; and a bullet of radius 0.05 at height `top - 10` flying at
+/// `speed` towards the right wall.
+fn bullet_over_pile(
+    method: Method,
+    speed: f64,
+    rows: usize,
+    per_row: usize,
+    t: f64,
+    top: f64,
+) -> (World<DVec2>, critterbox::CritterId) {
+    let mut w = well(method, DVec2::new(30.0, top), top - 5.0, t);
+    for row in 0..rows {
+        let count = if row % 2 == 1 {
+            per_row.min(8)
+        } else {
+            per_row
+        };
+        for k in 0..count {
             let x = 1.0 + k as f64 * 1.000_001 + if row % 2 == 1 { 0.5 } else { 0.0 };
             let y = 0.5 + 1e-6 + row as f64 * 0.866_026;
             w.spawn(
@@ -625,7 +645,7 @@ fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::Cri
     }
     let bullet = w
         .spawn(
-            CritterSpec::ball(DVec2::new(5.15, 20.0))
+            CritterSpec::ball(DVec2::new(5.15, top - 10.0))
                 .radius(0.05)
                 .vel(DVec2::new(speed, 0.0)),
         )
@@ -633,18 +653,37 @@ fn pile_and_bullet(method: Method, speed: f64) -> (World<DVec2>, critterbox::Cri
     (w, bullet)
 }
 
-/// A heap of 180 balls (radius 0.5, e 0.5) dropped from 60 to 90 units into a box with a
-/// 0.02-thick floor and walls, stepped for 6 s under `method`; the number of steps `auto` cut
-/// into substeps (0 under other methods).
-fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
-    let mut w = well(method, DVec2::new(12.0, 100.0), 98.0, 0.02);
-    for row in 0..20 {
-        for k in 0..9 {
-            let pos = DVec2::new(1.0 + k as f64, 60.0 + 1.5 * row as f64);
-            w.spawn(CritterSpec::ball(pos).radius(0.5).restitution(0.5))
-                .unwrap();
-        }
+/// A swept step whose resting contacts run out of the event budget (a pile of 20 rows of 9 and 8
+/// balls, e 0.5, in a well 0.02 thick) stops everyone where the budget ran out and takes the
+/// rest in discrete substeps short enough not to tunnel (`src/method/swept.rs`): a bullet of
+/// radius 0.05 fired at 150 above the pile bounces off the side wall. Flown straight to the
+/// step's end (as before 2026-12-04) it passed through: 2.5 per step against the 0.06 of its
+/// radius and half the wall. Under 64 (r + T/2) / dt = 230 the substeps hold.
+#[test]
+fn a_swept_step_out_of_events_finishes_in_substeps_that_do_not_tunnel() {
+    let (mut w, bullet) = bullet_over_pile(Method::Swept, 150.0, 20, 9, 0.02, 35.0);
+    let mut out_of_events = 0;
+    for _ in 0..10 {
+        w.step().unwrap();
+        out_of_events += w.stats().budget_exceeded;
+        let b = w.get(bullet).unwrap();
+        assert!(b.pos.x < 10.0, "the bullet passed the wall: {:?}", b.pos);
     }
+    assert!(
+        out_of_events >= 2,
+        "the pile ran out of events in {out_of_events} steps"
+    );
+    assert!(
+        w.get(bullet).unwrap().vel.x < -100.0,
+        "the bullet did not bounce"
+    );
+}
+
+/// The dropped heap of `docs/stability.md` (`critterbox::stability::dropped_heap_world`), 180
+/// balls, stepped for 6 s under `method`; the number of steps `auto` cut into substeps (0 under
+/// other methods).
+fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
+    let mut w = critterbox::stability::dropped_heap_world(method).unwrap();
     let mut substeps = 0;
     for _ in 0..360 {
         w.step().unwrap();
@@ -654,25 +693,32 @@ fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
     (w, substeps)
 }
 
-/// `auto` cuts a solved step into substeps when critters fall fast (`src/method/auto.rs`): the
-/// dropped heap's balls reach 34 to 42 units per second, 0.57 to 0.7 per step, more than what
-/// carries a ball's centre past the floor's mid-plane (its radius and half the floor, 0.51).
-/// Fixed `solve:8` lets a ball through the floor; each of auto's substeps moves a ball less than
-/// half that, so every ball stays in, and the heap is solved as it lands.
+/// The dropped heap's row of `docs/stability.md`: its balls land at 0.57 to 0.7 per step, more
+/// than what carries a ball's centre past the floor's mid-plane (its radius and half the
+/// floor, 0.51). The discrete step and `solve:8` let balls through the floor. Substeps, `swept`
+/// (whose landing heap runs out of events and finishes those steps in short substeps), the
+/// event method and `auto` keep every ball in.
 #[test]
-fn auto_cuts_a_fast_falling_heap_into_solved_substeps_and_keeps_every_ball_in() {
-    let inside = |w: &World<DVec2>| {
-        let balls = w.critters().iter().filter(|c| !c.is_wall());
-        balls
-            .filter(|b| b.pos.x > 0.0 && b.pos.x < 10.0 && b.pos.y > 0.0)
-            .count()
-    };
-    let (w, _) = dropped_heap(Method::Solve(8));
-    assert!(inside(&w) < 180, "solve:8 kept every ball in");
+fn a_dropped_heap_goes_through_a_thin_floor_in_whole_discrete_steps_only() {
+    let heap = stress(STRESS, "dropped heap");
+    for m in METHODS {
+        let out = (heap.run)(m).unwrap();
+        match m {
+            Method::Discrete | Method::Solve(_) => assert!(out > 0.0, "{m} kept every ball in"),
+            _ => assert_eq!(out, 0.0, "{m} let {out} balls out"),
+        }
+    }
+}
 
+/// `auto` cuts a solved step into substeps when critters fall fast (`src/method/auto.rs`), and
+/// each of its substeps moves a ball less than half what would carry it past the floor's
+/// mid-plane: every ball of the dropped heap stays in (asserted above), and the heap is solved
+/// as it lands, overlapping less than a fifth of a radius.
+#[test]
+fn auto_cuts_a_fast_falling_heap_into_solved_substeps() {
     let (w, substeps) = dropped_heap(Method::Auto);
     assert!(substeps > 0, "auto never cut a step into substeps");
-    assert_eq!(inside(&w), 180, "auto let a ball out");
+    assert_eq!(critterbox::stability::balls_out_of_the_well(&w), 0);
     let balls: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
     let mut deepest: f64 = 0.0;
     for (i, a) in balls.iter().enumerate() {

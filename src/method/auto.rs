@@ -18,7 +18,8 @@
 //! substeps as keep each critter under half of what would carry it through a wall or a disk in
 //! one substep ([`tunnel_fraction`]), up to [`MOST_SOLVE_SUBSTEPS`]; a step that would need more
 //! is swept. A heap falling fast is then solved as it lands: swept, a dense heap runs out of the
-//! swept step's event budget and its discrete pass pushes balls through the floor. A pair that
+//! swept step's event budget every step, and its discrete substeps let the heap sink into itself
+//! and through the floor. A pair that
 //! meets alone gets Pop's impulse from the solve, and a step with no contacts builds nothing to
 //! solve. Critters sliding down a pile move faster than the sweep threshold, which guards the
 //! angles of glancing hits; the solve's angles are the discrete step's, and it is the stack that

@@ -17,9 +17,9 @@ use crate::world::{StepStats, World};
 pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
     let clock = std::time::Instant::now();
     let g = world.gravity;
-    let complete = crate::method::flight::run(world, g, world.dt, None, stats)?;
+    let stopped = crate::method::flight::run(world, g, world.dt, None, false, stats)?;
     stats.response += clock.elapsed();
-    if !complete {
+    if stopped.is_some() {
         stats.budget_exceeded += 1;
         world.discrete_collide(stats)?;
     }

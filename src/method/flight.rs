@@ -24,8 +24,10 @@
 //! Inelastic collapse: a collision within `TC_FRACTION x dt` of either critter's previous one is
 //! elastic (the TC model of Luding and McNamara), which stops the infinite sequence of ever
 //! shorter intervals. An event budget per step bounds the cost of what remains (resting
-//! contacts under gravity); when it runs out the step is finished by the discrete pass and
-//! counted in `StepStats::budget_exceeded`.
+//! contacts under gravity); when it runs out (counted in `StepStats::budget_exceeded`) the
+//! critters are stopped where they are and `swept` finishes the step in discrete substeps short
+//! enough not to tunnel, or they fly straight to the end and `event` finishes the step with the
+//! discrete pass.
 
 use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
@@ -214,6 +216,8 @@ pub(crate) struct Scratch<V> {
     least_rmax: f64,
     /// Slower critters predict at the flight's start only if they may meet something (`run`).
     fast: Option<f64>,
+    /// When the event budget runs out, stop everyone there rather than fly them to the end.
+    stop_early: bool,
     /// Cells only, even where shells would pay (tests compare the two).
     #[cfg(test)]
     no_shells: bool,
@@ -251,8 +255,9 @@ pub(crate) struct Scratch<V> {
 }
 
 /// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
-/// processing every event in order. Returns false when the event budget ran out (the critters
-/// are then all at `t_end`, with the remaining events skipped).
+/// processing every event in order. Returns `None` when every event was processed, or the time
+/// the critters are at when the event budget ran out: where it ran out with `stop_early`,
+/// otherwise `t_end` (the remaining events skipped).
 ///
 /// `fast`: when set, a critter that moves less than it in the flight predicts at the start only
 /// if it may meet something along its line (`may_meet`); otherwise it joins in when a collision
@@ -262,10 +267,12 @@ pub(crate) fn run<V: Vector>(
     acc: V,
     t_end: f64,
     fast: Option<f64>,
+    stop_early: bool,
     stats: &mut StepStats,
-) -> Result<bool, Error> {
+) -> Result<Option<f64>, Error> {
     let mut sc = std::mem::take(&mut world.flight);
     sc.fast = fast;
+    sc.stop_early = stop_early;
     let out = run_with(world, &mut sc, acc, t_end, stats);
     sc.heap.reset(0, 0.0, 0.0);
     world.flight = sc;
@@ -281,7 +288,7 @@ fn run_with<V: Vector>(
     acc: V,
     t_end: f64,
     stats: &mut StepStats,
-) -> Result<bool, Error> {
+) -> Result<Option<f64>, Error> {
     sc.least_rmax = 0.0;
     let (mut flown, mut virial) = (0.0, 0.0);
     loop {
@@ -289,7 +296,7 @@ fn run_with<V: Vector>(
         virial += sc.virial;
         sc.virial = virial;
         match outcome? {
-            Flight::Done(complete) => return Ok(complete),
+            Flight::Done(stopped) => return Ok(stopped.map(|t| flown + t)),
             Flight::Grown(t) => flown += t,
         }
     }
@@ -297,8 +304,8 @@ fn run_with<V: Vector>(
 
 /// How a flight ended.
 enum Flight {
-    /// At its end; false when the event budget ran out.
-    Done(bool),
+    /// At its end, or where the event budget ran out (the time everyone is at).
+    Done(Option<f64>),
     /// At this time, because a hook grew a critter beyond what the cells were sized for.
     Grown(f64),
 }
@@ -321,7 +328,7 @@ fn fly<V: Vector>(
         }
     }
     let mut processed = 0u64;
-    let mut complete = true;
+    let mut stopped = None;
     let mut grown = None;
     // Every branch below predicts the event's owner again (which replaces the event in the
     // queue) or removes the event.
@@ -342,7 +349,7 @@ fn fly<V: Vector>(
         }
         processed += 1;
         if processed > sc.budget {
-            complete = false;
+            stopped = Some(if sc.stop_early { ev.time } else { t_end });
             break;
         }
         let t = ev.time;
@@ -424,7 +431,7 @@ fn fly<V: Vector>(
     stats.pair_tests += sc.pair_tests;
     stats.candidates += sc.predictions as usize;
     // Everyone to the end of the flight.
-    let end = grown.unwrap_or(t_end);
+    let end = grown.or(stopped).unwrap_or(t_end);
     let topo = w.topo;
     for a in 0..n {
         advance(w, sc, a, end);
@@ -440,7 +447,7 @@ fn fly<V: Vector>(
     }
     Ok(match grown {
         Some(t) => Flight::Grown(t),
-        None => Flight::Done(complete),
+        None => Flight::Done(stopped),
     })
 }
 

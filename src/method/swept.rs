@@ -6,7 +6,9 @@
 //! the radius: faces, edges, corners, [`crate::method::toi::toi_wall_ball`]) are processed in time
 //! order by the shared event engine ([`crate::method::flight`]): advance the pair to its time of
 //! impact, hand it to the caller's `collide` hook, re-predict for the pair's critters. Then one
-//! discrete pass resolves what still touches (resting contacts, spawned overlaps).
+//! discrete pass resolves what still touches (resting contacts, spawned overlaps). Where resting
+//! contacts under gravity exhaust the flight's event budget, the rest of the step is taken in
+//! discrete substeps short enough not to tunnel ([`MOST_TAIL_SUBSTEPS`] at most).
 //!
 //! A step in which no critter moves more than [`SWEEP_FRACTION`] of the smallest radius (or of
 //! the thinnest wall) is exactly the discrete step: sweeping is paid for only when needed.
@@ -105,7 +107,7 @@ fn sweep<V: Vector>(
     let scale = motion_scale(world);
     let limit = SWEEP_FRACTION * scale.smallest();
     if scale.fastest <= limit {
-        return world.substeps(1, None, stats);
+        return world.substeps(world.dt, 1, None, stats);
     }
     let clock = std::time::Instant::now();
     let dv = world.gravity * world.dt;
@@ -115,10 +117,42 @@ fn sweep<V: Vector>(
         }
     }
     let fast = fast_only.then_some(limit);
-    let complete = crate::method::flight::run(world, V::zero(), world.dt, fast, stats)?;
-    if !complete {
-        stats.budget_exceeded += 1;
-    }
+    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, true, stats)?;
     stats.response += clock.elapsed();
-    world.discrete_collide(stats)
+    match stopped {
+        None => world.discrete_collide(stats),
+        Some(at) => {
+            stats.budget_exceeded += 1;
+            finish_in_substeps(world, world.dt - at, limit, stats)
+        }
+    }
 }
+
+/// Finishes a step whose flight ran out of its event budget (resting contacts under gravity)
+/// `rest` before its end: gravity's kick for the rest is taken back, and the rest is stepped in
+/// discrete substeps in which no critter moves more than `limit` (so none tunnels, as in a step
+/// that needs no sweeping), at most [`MOST_TAIL_SUBSTEPS`] of them.
+fn finish_in_substeps<V: Vector>(
+    world: &mut World<V>,
+    rest: f64,
+    limit: f64,
+    stats: &mut StepStats,
+) -> Result<(), Error> {
+    let g = world.gravity;
+    let mut fastest: f64 = 0.0;
+    for c in world.critters.iter_mut_moving() {
+        if c.alive && !c.is_wall() {
+            if !c.fixed {
+                c.vel -= g * rest;
+            }
+            fastest = fastest.max(c.vel.length() + g.length() * rest);
+        }
+    }
+    let n = (fastest * rest / limit)
+        .ceil()
+        .clamp(1.0, f64::from(MOST_TAIL_SUBSTEPS));
+    world.substeps(rest, n as u32, None, stats)
+}
+
+/// The most discrete substeps that finish a swept step whose event budget ran out.
+pub const MOST_TAIL_SUBSTEPS: u32 = 64;
