@@ -10,6 +10,7 @@
 //! inelastic collapse and resting contacts.
 
 use crate::error::Error;
+use crate::method::swept::{finish_in_substeps, motion_scale, SWEEP_FRACTION};
 use crate::vector::Vector;
 use crate::world::{StepStats, World};
 
@@ -17,11 +18,12 @@ use crate::world::{StepStats, World};
 pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
     let clock = std::time::Instant::now();
     let g = world.gravity;
-    let stopped = crate::method::flight::run(world, g, world.dt, None, false, stats)?;
+    let stopped = crate::method::flight::run(world, g, world.dt, None, stats)?;
     stats.response += clock.elapsed();
-    if stopped.is_some() {
+    if let Some(at) = stopped {
         stats.budget_exceeded += 1;
-        world.discrete_collide(stats)?;
+        let limit = SWEEP_FRACTION * motion_scale(world).smallest();
+        finish_in_substeps(world, world.dt - at, limit, false, stats)?;
     }
     Ok(())
 }

@@ -25,9 +25,8 @@
 //! elastic (the TC model of Luding and McNamara), which stops the infinite sequence of ever
 //! shorter intervals. An event budget per step bounds the cost of what remains (resting
 //! contacts under gravity); when it runs out (counted in `StepStats::budget_exceeded`) the
-//! critters are stopped where they are and `swept` finishes the step in discrete substeps short
-//! enough not to tunnel, or they fly straight to the end and `event` finishes the step with the
-//! discrete pass.
+//! critters are stopped where they are, and `swept` and `event` finish the step in discrete
+//! substeps short enough not to tunnel.
 
 use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
@@ -216,8 +215,6 @@ pub(crate) struct Scratch<V> {
     least_rmax: f64,
     /// Slower critters predict at the flight's start only if they may meet something (`run`).
     fast: Option<f64>,
-    /// When the event budget runs out, stop everyone there rather than fly them to the end.
-    stop_early: bool,
     /// Cells only, even where shells would pay (tests compare the two).
     #[cfg(test)]
     no_shells: bool,
@@ -256,8 +253,7 @@ pub(crate) struct Scratch<V> {
 
 /// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
 /// processing every event in order. Returns `None` when every event was processed, or the time
-/// the critters are at when the event budget ran out: where it ran out with `stop_early`,
-/// otherwise `t_end` (the remaining events skipped).
+/// the event budget ran out, where the critters were stopped (the caller finishes the step).
 ///
 /// `fast`: when set, a critter that moves less than it in the flight predicts at the start only
 /// if it may meet something along its line (`may_meet`); otherwise it joins in when a collision
@@ -267,12 +263,10 @@ pub(crate) fn run<V: Vector>(
     acc: V,
     t_end: f64,
     fast: Option<f64>,
-    stop_early: bool,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
     let mut sc = std::mem::take(&mut world.flight);
     sc.fast = fast;
-    sc.stop_early = stop_early;
     let out = run_with(world, &mut sc, acc, t_end, stats);
     sc.heap.reset(0, 0.0, 0.0);
     world.flight = sc;
@@ -349,7 +343,7 @@ fn fly<V: Vector>(
         }
         processed += 1;
         if processed > sc.budget {
-            stopped = Some(if sc.stop_early { ev.time } else { t_end });
+            stopped = Some(ev.time);
             break;
         }
         let t = ev.time;

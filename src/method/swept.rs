@@ -117,32 +117,34 @@ fn sweep<V: Vector>(
         }
     }
     let fast = fast_only.then_some(limit);
-    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, true, stats)?;
+    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, stats)?;
     stats.response += clock.elapsed();
     match stopped {
         None => world.discrete_collide(stats),
         Some(at) => {
             stats.budget_exceeded += 1;
-            finish_in_substeps(world, world.dt - at, limit, stats)
+            finish_in_substeps(world, world.dt - at, limit, true, stats)
         }
     }
 }
 
 /// Finishes a step whose flight ran out of its event budget (resting contacts under gravity)
-/// `rest` before its end: gravity's kick for the rest is taken back, and the rest is stepped in
-/// discrete substeps in which no critter moves more than `limit` (so none tunnels, as in a step
-/// that needs no sweeping), at most [`MOST_TAIL_SUBSTEPS`] of them.
-fn finish_in_substeps<V: Vector>(
+/// `rest` before its end: the rest is stepped in discrete substeps in which no critter moves
+/// more than `limit` (so none tunnels, as in a step that needs no sweeping), at most
+/// [`MOST_TAIL_SUBSTEPS`] of them. `kicked`: the step gave gravity's kick for the whole step up
+/// front (swept), and the rest's part of it is taken back first, since the substeps give it.
+pub(crate) fn finish_in_substeps<V: Vector>(
     world: &mut World<V>,
     rest: f64,
     limit: f64,
+    kicked: bool,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
     let g = world.gravity;
     let mut fastest: f64 = 0.0;
     for c in world.critters.iter_mut_moving() {
         if c.alive && !c.is_wall() {
-            if !c.fixed {
+            if kicked && !c.fixed {
                 c.vel -= g * rest;
             }
             fastest = fastest.max(c.vel.length() + g.length() * rest);
@@ -154,5 +156,5 @@ fn finish_in_substeps<V: Vector>(
     world.substeps(rest, n as u32, None, stats)
 }
 
-/// The most discrete substeps that finish a swept step whose event budget ran out.
+/// The most discrete substeps that finish a swept or event step whose event budget ran out.
 pub const MOST_TAIL_SUBSTEPS: u32 = 64;
