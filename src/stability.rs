@@ -176,25 +176,25 @@ fn max_overlap<V: Vector>(w: &World<V>) -> f64 {
 }
 
 fn floor_box(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
+    well(method, dt, DVec2::new(11.0, 30.0), 25.0, 0.2)
+}
+
+/// A world from (-1, -1) to `top` under gravity, with a well 10 wide: a floor and two side
+/// walls `height` high, all `t` thick, the floor's top at y = 0.
+fn well(method: Method, dt: f64, top: DVec2, height: f64, t: f64) -> Result<World<DVec2>, Error> {
     let mut w = World::new(
-        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(11.0, 30.0))
+        WorldConfig::new(DVec2::new(-1.0, -1.0), top)
             .dt(dt)
             .gravity(DVec2::new(0.0, -9.81))
             .method(method),
     )?;
-    let t = 0.2;
-    w.add_wall(WallBox::aligned(
-        DVec2::new(-t, -t),
-        DVec2::new(10.0 + t, 0.0),
-    )?)?;
-    w.add_wall(WallBox::aligned(
-        DVec2::new(-t, 0.0),
-        DVec2::new(0.0, 25.0),
-    )?)?;
-    w.add_wall(WallBox::aligned(
-        DVec2::new(10.0, 0.0),
-        DVec2::new(10.0 + t, 25.0),
-    )?)?;
+    for (lo, hi) in [
+        (DVec2::new(-t, -t), DVec2::new(10.0 + t, 0.0)),
+        (DVec2::new(-t, 0.0), DVec2::new(0.0, height)),
+        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, height)),
+    ] {
+        w.add_wall(WallBox::aligned(lo, hi)?)?;
+    }
     Ok(w)
 }
 
@@ -260,20 +260,7 @@ pub const DEEP_PILE_ROWS: usize = 20;
 /// and half the floor (0.51) that keep a ball's centre on the right side of the floor's
 /// mid-plane.
 pub fn dropped_heap_world(method: Method) -> Result<World<DVec2>, Error> {
-    let (t, height) = (0.02, 98.0);
-    let mut w = World::new(
-        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(12.0, 100.0))
-            .dt(DT)
-            .gravity(DVec2::new(0.0, -9.81))
-            .method(method),
-    )?;
-    for (lo, hi) in [
-        (DVec2::new(-t, -t), DVec2::new(10.0 + t, 0.0)),
-        (DVec2::new(-t, 0.0), DVec2::new(0.0, height)),
-        (DVec2::new(10.0, 0.0), DVec2::new(10.0 + t, height)),
-    ] {
-        w.add_wall(WallBox::aligned(lo, hi)?)?;
-    }
+    let mut w = well(method, DT, DVec2::new(12.0, 100.0), 98.0, 0.02)?;
     for row in 0..20 {
         for k in 0..9 {
             let pos = DVec2::new(1.0 + k as f64, 60.0 + 1.5 * row as f64);
