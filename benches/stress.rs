@@ -12,7 +12,9 @@
 //!   settled, it sleeps, as it would in Box2D or Rapier; `pile_9_layers_solve_8_awake` is the
 //!   same with sleep off, every contact solved every step; `pile_90_layers_solve_8` the deep
 //!   pile under `solve:8`, which never comes to rest; `pile_90_layers_solve_32` the deep pile
-//!   under `solve:32`, settled for 1,800 steps: 32 sweeps carry 90 layers' weight, and it sleeps).
+//!   under `solve:32`, settled for 1,800 steps: 32 sweeps carry 90 layers' weight, and it sleeps;
+//!   `pile_90_layers_auto` the deep pile under `auto`, settled for 1,800 steps: it counts the
+//!   pile's depth and gives its solve the sweeps that carry it, and the pile sleeps).
 //!
 //! `cargo bench --bench stress`; `docs/performance.md` has the figures. The target is each
 //! scene within 3x of the uniform gas per critter.
@@ -155,6 +157,9 @@ fn stress(c: &mut Criterion) {
         }),
         ("pile_90_layers_solve_32", || {
             pile_under(100.0, Method::Solve(32), true, 1800)
+        }),
+        ("pile_90_layers_auto", || {
+            pile_under(100.0, Method::Auto, true, 1800)
         }),
     ] {
         let mut world = build();

@@ -176,7 +176,13 @@ fn max_overlap<V: Vector>(w: &World<V>) -> f64 {
 }
 
 fn floor_box(method: Method, dt: f64) -> Result<World<DVec2>, Error> {
-    well(method, dt, DVec2::new(11.0, 30.0), 25.0, 0.2)
+    floor_box_for(method, dt, 0)
+}
+
+/// [`floor_box`], its walls raised where `rows` of balls would overtop them.
+fn floor_box_for(method: Method, dt: f64, rows: usize) -> Result<World<DVec2>, Error> {
+    let height = (rows as f64 + 5.0).max(25.0);
+    well(method, dt, DVec2::new(11.0, height + 5.0), height, 0.2)
 }
 
 /// A world from (-1, -1) to `top` under gravity, with a well 10 wide: a floor and two side
@@ -198,10 +204,10 @@ fn well(method: Method, dt: f64, top: DVec2, height: f64, t: f64) -> Result<Worl
     Ok(w)
 }
 
-/// `rows` rows of touching balls resting on the floor of `floor_box` (a hair apart, hexagonal),
-/// restitution 0.5.
-fn pile(method: Method, rows: usize, dt: f64) -> Result<World<DVec2>, Error> {
-    let mut w = floor_box(method, dt)?;
+/// `rows` rows of touching balls resting on the floor of a well 10 wide (a hair apart,
+/// hexagonal, 9 balls a row), radius 0.5, restitution 0.5: the resting and deep piles.
+pub fn pile(method: Method, rows: usize, dt: f64) -> Result<World<DVec2>, Error> {
+    let mut w = floor_box_for(method, dt, rows)?;
     let r = 0.5;
     for row in 0..rows {
         for k in 0..9 {

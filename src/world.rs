@@ -26,6 +26,7 @@ use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::hash::{StateHasher, LANES};
 use crate::kind::{KindDefaults, KindHooks, KindId, KindSet, WALL};
+use crate::method::solve::Sweeps;
 use crate::method::Method;
 use crate::rng::Rng;
 use crate::rules::{PairRule, RuleCache};
@@ -195,6 +196,9 @@ pub struct StepStats {
     /// step in discrete substeps (swept) or with a discrete pass (event); see
     /// `docs/stability.md`.
     pub budget_exceeded: u64,
+    /// Velocity sweeps taken by the solves of `solve:n` and `auto` (summed over substeps; a
+    /// solve with no contacts takes none).
+    pub sweeps: u64,
 }
 
 impl StepStats {
@@ -225,6 +229,7 @@ impl StepStats {
         self.impacts += o.impacts;
         self.events += o.events;
         self.budget_exceeded += o.budget_exceeded;
+        self.sweeps += o.sweeps;
     }
 }
 
@@ -893,11 +898,13 @@ impl<V: Vector> World<V> {
         stats.update = clock.elapsed();
         let mut per_critter = false;
         let mut substeps = 1;
+        let mut auto_sweeps = None;
         let method = match self.method {
             Method::Auto => {
                 let choice = crate::method::auto::choose(self);
                 per_critter = choice.per_critter;
                 substeps = choice.substeps;
+                auto_sweeps = Some(choice.sweeps);
                 self.auto_choice = Some((choice.method, choice.why));
                 choice.method
             }
@@ -921,7 +928,10 @@ impl<V: Vector> World<V> {
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
             Method::Event => crate::method::event::step(self, &mut stats)?,
-            Method::Solve(n) => self.substeps(self.dt, substeps, Some(n), &mut stats)?,
+            Method::Solve(n) => {
+                let sweeps = auto_sweeps.unwrap_or(Sweeps::Fixed(n));
+                self.substeps(self.dt, substeps, Some(sweeps), &mut stats)?
+            }
         }
         let clock = Instant::now();
         self.stage_lifecycle()?;
@@ -947,7 +957,7 @@ impl<V: Vector> World<V> {
         &mut self,
         span: f64,
         n: u32,
-        solve: Option<u32>,
+        solve: Option<Sweeps>,
         stats: &mut StepStats,
     ) -> Result<(), Error> {
         let h = span / f64::from(n);
@@ -970,7 +980,7 @@ impl<V: Vector> World<V> {
     /// move of `h`.
     fn collide_stages(
         &mut self,
-        solve: Option<(u32, f64)>,
+        solve: Option<(Sweeps, f64)>,
         stats: &mut StepStats,
     ) -> Result<(), Error> {
         let mut clock = Instant::now();
@@ -1000,7 +1010,11 @@ impl<V: Vector> World<V> {
         self.sort_contacts();
         lap(&mut stats.narrow_phase);
         let collisions = match solve {
-            Some((n, h)) => self.stage_solve(n, h)?,
+            Some((sweeps, h)) => {
+                let handled = self.stage_solve(sweeps, h)?;
+                stats.sweeps += u64::from(self.solve.swept);
+                handled
+            }
             None => self.stage_response()?,
         };
         lap(&mut stats.response);

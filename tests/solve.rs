@@ -5,7 +5,10 @@
 use critterbox::context::CollideCtx;
 use critterbox::glam::DVec2;
 use critterbox::kind::{KindDefaults, KindHooks};
+use critterbox::method::auto::{AUTO_MOST_SWEEPS, AUTO_SWEEPS};
+use critterbox::method::solve::LAYERS_PER_SWEEP;
 use critterbox::scenes::{gas, GasParams};
+use critterbox::stability::pile;
 use critterbox::wall::WallBox;
 use critterbox::{Border, CritterSpec, Error, Method, World, WorldConfig};
 use std::rc::Rc;
@@ -191,4 +194,125 @@ fn solve_tunnels_as_discrete_does_and_spreads_the_cradle_s_momentum() {
     let cradle = STRESS.iter().find(|s| s.name == "cradle").unwrap();
     assert!((cradle.run)(m).unwrap() > 0.5);
     assert_eq!((cradle.run)(Method::Discrete).unwrap(), 0.0);
+}
+
+/// A column of `n` balls of radius 0.25, each overlapping the next by 1e-3, the lowest a hair
+/// above the floor when `on_floor` (the step's fall, g dt^2 = 2.7e-3, brings it onto it;
+/// otherwise the column starts 1 above the floor), in a world under gravity stepped once under
+/// `auto`: the velocity sweeps its solve took.
+fn sweeps_of_a_column(n: usize, on_floor: bool) -> u64 {
+    let mut w = World::new(
+        WorldConfig::new(DVec2::ZERO, DVec2::new(20.0, 100.0))
+            .gravity(DVec2::new(0.0, -9.81))
+            .dt(DT)
+            .method(Method::Auto),
+    )
+    .unwrap();
+    w.add_wall(WallBox::aligned(DVec2::new(0.0, 0.0), DVec2::new(20.0, 0.5)).unwrap())
+        .unwrap();
+    let (r, gap) = (0.25, 1e-3);
+    let base = if on_floor { 0.5 + r + 1e-6 } else { 1.5 };
+    for k in 0..n {
+        let y = base + k as f64 * (2.0 * r - gap);
+        w.spawn(CritterSpec::ball(DVec2::new(5.0, y)).radius(r))
+            .unwrap();
+    }
+    w.step().unwrap();
+    assert_eq!(
+        w.auto_choice().map(|c| c.0),
+        Some(Method::Solve(AUTO_SWEEPS))
+    );
+    w.stats().sweeps
+}
+
+/// A ball in a resting column is as many contacts from the floor as it is balls up, and `auto`
+/// gives the solve one sweep per `LAYERS_PER_SWEEP` of them beyond its `AUTO_SWEEPS`, up to
+/// `AUTO_MOST_SWEEPS`; a column in free fall carries no weight and gets the least.
+#[test]
+fn auto_gives_a_column_one_sweep_per_two_balls_of_its_height() {
+    assert_eq!(LAYERS_PER_SWEEP, 2, "the expected counts below are for 2");
+    assert_eq!((AUTO_SWEEPS, AUTO_MOST_SWEEPS), (8, 64));
+    assert_eq!(sweeps_of_a_column(10, true), 8);
+    assert_eq!(sweeps_of_a_column(17, true), 9);
+    assert_eq!(sweeps_of_a_column(40, true), 20);
+    assert_eq!(sweeps_of_a_column(150, true), 64);
+    assert_eq!(sweeps_of_a_column(40, false), 8);
+}
+
+/// A row of 50 balls between two walls, its end balls moving into them: the walls hold it
+/// sideways, not up (they have no friction), and the balls' contacts with each other are
+/// level, so nothing bears its weight (were the walls supports, the middle balls would be 25
+/// contacts deep).
+#[test]
+fn side_walls_and_level_contacts_carry_no_weight() {
+    let mut w = World::new(
+        WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(30.0, 10.0))
+            .gravity(DVec2::new(0.0, -9.81))
+            .dt(DT)
+            .method(Method::Auto),
+    )
+    .unwrap();
+    let (r, gap, n) = (0.25, 0.02, 50);
+    let right = 2.0 * r + (n - 1) as f64 * (2.0 * r - gap) + 2e-6;
+    for (lo, hi) in [
+        (DVec2::new(-0.5, 0.0), DVec2::new(0.0, 5.0)),
+        (DVec2::new(right, 0.0), DVec2::new(right + 0.5, 5.0)),
+    ] {
+        w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
+    }
+    for k in 0..n {
+        let x = r + 1e-6 + k as f64 * (2.0 * r - gap);
+        let vx = match k {
+            0 => -1.0,
+            k if k == n - 1 => 1.0,
+            _ => 0.0,
+        };
+        let ball = CritterSpec::ball(DVec2::new(x, 2.0)).vel(DVec2::new(vx, 0.0));
+        w.spawn(ball.radius(r)).unwrap();
+    }
+    w.step().unwrap();
+    let solved = w.events().collisions.len();
+    assert_eq!(solved, n + 1, "neighbours and both walls");
+    assert_eq!(w.stats().sweeps, u64::from(AUTO_SWEEPS));
+}
+
+/// `critterbox::stability::pile` (rows of 9 balls of radius 0.5, e = 0.5, stacked hexagonally a
+/// hair apart in a well 10 wide) under `method` with sleep on: the step by which every ball is
+/// asleep (None if not by `limit`), and the deepest overlap then, in radii.
+fn well_pile(method: Method, rows: usize, limit: u64) -> (Option<u64>, f64) {
+    let r = 0.5;
+    let mut w = pile(method, rows, DT).unwrap();
+    let balls = w.critters().iter().filter(|c| !c.is_wall()).count();
+    let mut asleep = None;
+    for step in 1..=limit {
+        w.step().unwrap();
+        if w.sleepers() == balls {
+            asleep = Some(step);
+            break;
+        }
+    }
+    let cs: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
+    let mut deepest: f64 = 0.0;
+    for (i, a) in cs.iter().enumerate() {
+        deepest = deepest.max((r - a.pos.y) / r);
+        for b in &cs[i + 1..] {
+            deepest = deepest.max((2.0 * r - a.pos.distance(b.pos)) / r);
+        }
+    }
+    (asleep, deepest)
+}
+
+/// Eight sweeps do not carry 40 rows: the pile keeps moving and never sleeps in 10 s. `auto`
+/// counts the pile's depth and gives it the sweeps it needs (about 20): it comes to rest and
+/// sleeps within 10 s, overlapping by under a tenth of a radius.
+#[test]
+fn auto_brings_a_pile_too_deep_for_eight_sweeps_to_rest() {
+    let (asleep, deepest) = well_pile(Method::Solve(8), 40, 600);
+    assert_eq!(asleep, None, "solve:8 slept (deepest overlap {deepest})");
+    let (asleep, deepest) = well_pile(Method::Auto, 40, 600);
+    assert!(
+        asleep.is_some(),
+        "auto did not sleep (deepest overlap {deepest})"
+    );
+    assert!(deepest < 0.1, "auto's deepest overlap {deepest} radii");
 }

@@ -411,6 +411,13 @@ fn stats(
         t.ruled as f64 / n,
         t.contacts as f64 / n
     )?;
+    if t.sweeps > 0 {
+        writeln!(
+            out,
+            "solve        {:.1} velocity sweeps per step (summed over substeps)",
+            t.sweeps as f64 / n
+        )?;
+    }
     Ok(())
 }
 

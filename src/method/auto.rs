@@ -18,7 +18,10 @@
 //! Under gravity, critters come to rest on each other, and the discrete step lets stacks sink
 //! into themselves (the deep pile of `docs/stability.md`: 1.92 radii after 2 s). So a step under
 //! gravity is solved, `solve:8`, at about the discrete step's cost (0.036 radii there), and its
-//! islands at rest sleep. So that no critter can tunnel, the solved step is cut into as many
+//! islands at rest sleep. Eight sweeps carry a pile about 16 contacts deep; a deeper one gets one
+//! sweep more per [`LAYERS_PER_SWEEP`] layers, up to [`AUTO_MOST_SWEEPS`], counted by the solve
+//! each time ([`Sweeps::ByDepth`]): without them a 90-layer pile never comes to rest, and never
+//! sleeps. So that no critter can tunnel, the solved step is cut into as many
 //! substeps as keep each critter under half of what would carry it through a wall or a disk in
 //! one substep ([`tunnel_fraction`]), up to [`MOST_SOLVE_SUBSTEPS`]; a step that would need more
 //! is swept. A heap falling fast is then solved as it lands: swept, a dense heap runs out of the
@@ -31,14 +34,20 @@
 //! Without gravity nothing rests, and `solve:n` would spread a Newton's cradle's momentum over
 //! its balls: the step stays discrete.
 
+use crate::method::solve::{Sweeps, LAYERS_PER_SWEEP};
 use crate::method::swept::{count_fast, displacement, motion_scale, MotionScale, SWEEP_FRACTION};
 use crate::method::Method;
 use crate::vector::Vector;
 use crate::world::World;
 
 /// The sweeps of the `solve:n` step `auto` takes under gravity (the stability table's
-/// `solve:8`).
+/// `solve:8`), at least.
 pub const AUTO_SWEEPS: u32 = 8;
+
+/// The most sweeps of `auto`'s solve: beyond [`AUTO_SWEEPS`] a pile gets one sweep per
+/// [`LAYERS_PER_SWEEP`] layers of weight-bearing contacts, as a deep pile needs to carry
+/// its weight.
+pub const AUTO_MOST_SWEEPS: u32 = 64;
 
 /// Below this packing fraction (disk area, or sphere volume, over the box's) a swept step is
 /// taken per critter.
@@ -58,6 +67,12 @@ pub fn packing<V: Vector>(world: &World<V>) -> f64 {
     covered / volume
 }
 
+/// The sweeps of `auto`'s solve.
+const AUTO: Sweeps = Sweeps::ByDepth {
+    least: AUTO_SWEEPS,
+    most: AUTO_MOST_SWEEPS,
+};
+
 /// What `auto` takes for the coming step.
 pub struct Choice {
     /// Discrete, swept, event or `solve:8`.
@@ -66,6 +81,8 @@ pub struct Choice {
     pub per_critter: bool,
     /// Substeps of a solved step (1 otherwise).
     pub substeps: u32,
+    /// Sweeps of a solved step.
+    pub sweeps: Sweeps,
     /// Why, for `critterbox run`.
     pub why: String,
 }
@@ -113,9 +130,12 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
             method: Method::Solve(AUTO_SWEEPS),
             per_critter: false,
             substeps,
+            sweeps: AUTO,
             why: format!(
-                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; {how}; {} asleep",
-                world.sleepers()
+                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; {how}; a pile more than {deep} contacts deep gets one sweep more per {per} layers (up to {AUTO_MOST_SWEEPS}), as its weight needs; {asleep} asleep",
+                deep = AUTO_SWEEPS * LAYERS_PER_SWEEP,
+                per = LAYERS_PER_SWEEP,
+                asleep = world.sleepers()
             ),
         }
     } else if fastest <= limit {
@@ -123,6 +143,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
             method: Method::Discrete,
             per_critter: false,
             substeps: 1,
+            sweeps: AUTO,
             why: format!(
                 "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
             ),
@@ -144,6 +165,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
                 method: Method::Event,
                 per_critter: false,
                 substeps: 1,
+            sweeps: AUTO,
                 why: format!("event: {fast_why}; the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone would be swept, and without gravity nothing rests: the exact event-driven step flies the same events without the swept step's closing discrete pass"),
             }
         } else {
@@ -151,6 +173,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
                 method: Method::Swept,
                 per_critter,
                 substeps: 1,
+                sweeps: AUTO,
                 why: format!("swept: {fast_why}; {slow}"),
             }
         }

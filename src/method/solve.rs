@@ -15,7 +15,9 @@
 //!    again by the sweeps every step);
 //! 3. `n` sweeps over the contacts, alternately forwards and backwards, each correct one
 //!    contact's normal velocity towards its wanted value with an impulse, keeping the contact's
-//!    accumulated impulse non-negative (contacts push, never pull);
+//!    accumulated impulse non-negative (contacts push, never pull); under `auto`, as many as the
+//!    pile's depth in weight-bearing contacts asks ([`Sweeps::ByDepth`], `contact_depth`),
+//!    since the sweeps carry its weight down one contact at a time;
 //! 4. the critters are moved on by the solve's change of velocity times dt: the move advanced
 //!    them by their velocities before it, and semi-implicit Euler advances them by the solved
 //!    ones (a ball resting on the floor does not sink by g dt^2 every step);
@@ -56,6 +58,32 @@ pub const POSITION_SHARE: f64 = 0.2;
 
 /// Largest move of one pair in one position sweep, in radii of the smaller critter.
 pub const LARGEST_CORRECTION: f64 = 0.2;
+
+/// How many velocity sweeps a solve takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sweeps {
+    /// Exactly this many (`solve:n`).
+    Fixed(u32),
+    /// As many as the pile's depth asks ([`sweeps_for_depth`]), from `least` to `most`
+    /// (`auto`).
+    ByDepth {
+        /// Sweeps at least.
+        least: u32,
+        /// Sweeps at most.
+        most: u32,
+    },
+}
+
+/// Layers of a pile one velocity sweep carries, for [`Sweeps::ByDepth`].
+pub const LAYERS_PER_SWEEP: u32 = 2;
+
+/// The sweeps a pile `depth` contacts deep gets: one per [`LAYERS_PER_SWEEP`] layers, from
+/// `least` to `most`.
+pub fn sweeps_for_depth(depth: u32, least: u32, most: u32) -> u32 {
+    depth
+        .div_ceil(LAYERS_PER_SWEEP)
+        .clamp(least, most.max(least))
+}
 
 /// Position sweeps per step (fewer once every overlap is within three slops).
 pub const POSITION_SWEEPS: u32 = 3;
@@ -113,6 +141,9 @@ pub(crate) struct Scratch<V> {
     plain: Vec<(u32, u32)>,
     /// The rows' pair keys, in the order the rows were built.
     keys: Vec<u64>,
+    /// Velocity sweeps the last solve took (0 with no contacts).
+    pub(crate) swept: u32,
+    graph: Graph,
     /// The last step's accumulated impulses by pair key, ascending: the only state the solve
     /// carries from one step to the next (recorded with every full state).
     pub(crate) warm: Vec<(u64, f64)>,
@@ -130,6 +161,8 @@ impl<V> Default for Scratch<V> {
             pos: Vec::new(),
             plain: Vec::new(),
             keys: Vec::new(),
+            swept: 0,
+            graph: Graph::default(),
             warm: Vec::new(),
         }
     }
@@ -138,14 +171,14 @@ impl<V> Default for Scratch<V> {
 impl<V: Vector> World<V> {
     /// The response stage of `solve:n`: hooks first, then the rest solved together, after a move
     /// of `h` (the step, or under `auto` a substep of it). Returns how many pairs were handled.
-    pub(crate) fn stage_solve(&mut self, sweeps: u32, h: f64) -> Result<usize, Error> {
+    pub(crate) fn stage_solve(&mut self, sweeps: Sweeps, h: f64) -> Result<usize, Error> {
         let mut scratch = std::mem::take(&mut self.solve);
         let result = self.solve_with(&mut scratch, sweeps, h);
         self.solve = scratch;
         result
     }
 
-    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: u32, h: f64) -> Result<usize, Error> {
+    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: Sweeps, h: f64) -> Result<usize, Error> {
         let mut handled = 0;
         // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
         s.plain.clear();
@@ -276,7 +309,21 @@ impl<V: Vector> World<V> {
         std::mem::swap(&mut s.rests, &mut s.spare_rests);
 
         // 3. Velocities: sweeps of sequential impulses, alternately forwards and backwards.
-        for sweep in 0..sweeps {
+        let count = match sweeps {
+            Sweeps::Fixed(n) => n,
+            Sweeps::ByDepth { least, most } => {
+                let g = self.gravity.length();
+                let down = if g > 0.0 {
+                    self.gravity * (1.0 / g)
+                } else {
+                    V::zero()
+                };
+                let depth = contact_depth(&s.rows, &s.bodies, down, &mut s.graph);
+                sweeps_for_depth(depth, least, most)
+            }
+        };
+        s.swept = if s.rows.is_empty() { 0 } else { count };
+        for sweep in 0..s.swept {
             if sweep % 2 == 0 {
                 for row in s.rows.iter_mut() {
                     push_velocities(row, &mut s.bodies);
@@ -470,4 +517,76 @@ fn push_velocities<V: Vector>(row: &mut Row<V>, bodies: &mut [Body<V>]) {
     row.impulse = total;
     bodies[a].vel -= row.n * (j * bodies[a].inv_mass);
     bodies[b].vel += row.n * (j * bodies[b].inv_mass);
+}
+
+/// The contact graph's working arrays for [`contact_depth`].
+#[derive(Debug, Default)]
+pub(crate) struct Graph {
+    /// Where each body's neighbours start in `next` (one more entry than bodies).
+    start: Vec<u32>,
+    next: Vec<u32>,
+    /// Contacts from the nearest support, `u32::MAX` for not reached yet.
+    depth: Vec<u32>,
+    queue: Vec<u32>,
+}
+
+/// A contact carries weight when its normal is at least this far from horizontal: the cosine
+/// between the normal and gravity (about 6 degrees from horizontal).
+pub const LOAD_BEARING: f64 = 0.1;
+
+/// How many contacts deep the pile of `rows` is: the most contacts any movable body is from the
+/// nearest support (a wall, a fixed critter or a sleeper: a body of zero inverse mass) along
+/// touching pairs that carry weight (their normal at least [`LOAD_BEARING`] along `down`, the
+/// direction of gravity), by breadth-first search from every support at once. A ball against a
+/// side wall is not held up by it (walls have no friction), and bodies that reach no support (a
+/// cluster in free fall) carry no weight and do not count. 0 with no contacts.
+fn contact_depth<V: Vector>(rows: &[Row<V>], bodies: &[Body<V>], down: V, g: &mut Graph) -> u32 {
+    let n = bodies.len();
+    let bearing = |row: &&Row<V>| row.n.dot(down).abs() >= LOAD_BEARING;
+    g.start.clear();
+    g.start.resize(n + 1, 0);
+    for row in rows.iter().filter(bearing) {
+        g.start[row.a as usize + 1] += 1;
+        g.start[row.b as usize + 1] += 1;
+    }
+    for i in 0..n {
+        g.start[i + 1] += g.start[i];
+    }
+    g.next.clear();
+    g.next.resize(g.start[n] as usize, 0);
+    // `depth` serves as each body's fill cursor first.
+    g.depth.clear();
+    g.depth.extend_from_slice(&g.start[..n]);
+    for row in rows.iter().filter(bearing) {
+        for (from, to) in [(row.a, row.b), (row.b, row.a)] {
+            let at = &mut g.depth[from as usize];
+            g.next[*at as usize] = to;
+            *at += 1;
+        }
+    }
+    g.queue.clear();
+    for (i, body) in bodies.iter().enumerate() {
+        let touched = g.start[i + 1] > g.start[i];
+        if body.inv_mass == 0.0 && touched {
+            g.depth[i] = 0;
+            g.queue.push(i as u32);
+        } else {
+            g.depth[i] = u32::MAX;
+        }
+    }
+    let (mut head, mut deepest) = (0, 0);
+    while let Some(&at) = g.queue.get(head) {
+        head += 1;
+        let d = g.depth[at as usize] + 1;
+        let (lo, hi) = (g.start[at as usize], g.start[at as usize + 1]);
+        for k in lo..hi {
+            let to = g.next[k as usize] as usize;
+            if g.depth[to] == u32::MAX {
+                g.depth[to] = d;
+                deepest = d;
+                g.queue.push(to as u32);
+            }
+        }
+    }
+    deepest
 }
