@@ -193,8 +193,7 @@ pub struct StepStats {
     /// crossings).
     pub events: u64,
     /// Steps in which the swept or event method ran out of its event budget and finished the
-    /// step in discrete substeps (swept) or with a discrete pass (event); see
-    /// `docs/stability.md`.
+    /// step in discrete substeps; see `docs/stability.md`.
     pub budget_exceeded: u64,
     /// Velocity sweeps taken by the solves of `solve:n` and `auto` (summed over substeps; a
     /// solve with no contacts takes none).
@@ -1224,6 +1223,10 @@ impl<V: Vector> World<V> {
     /// The contacts and wall pairs in the order of their lower slot, then their higher one: the
     /// order the response takes them in, whatever order the broad phase found them in.
     fn sort_contacts(&mut self) {
+        let listed = self.broad.listed();
+        let crowded =
+            !self.contacts.is_empty() && LISTED_PER_CONTACT * self.contacts.len() >= listed;
+        self.broad.set_crowded(crowded);
         let slots = self.critters.slot_count();
         if !sort_pairs(&mut self.contacts, slots)
             && self.contacts.len() >= RADIX_MIN
@@ -1631,7 +1634,8 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
 const RADIX_MIN: usize = 256;
 
 /// The broad phase's Verlet list is sorted once many contacts were (see
-/// [`BroadPhase::sort_list`]): when it holds at most this many pairs per contact.
+/// [`BroadPhase::sort_list`]), and leads only its fastest objects ([`BroadPhase::set_crowded`]):
+/// when it holds at most this many pairs per contact.
 const LISTED_PER_CONTACT: usize = 8;
 
 /// Bits per digit of the radix sort of pairs.

@@ -165,7 +165,7 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
                 method: Method::Event,
                 per_critter: false,
                 substeps: 1,
-            sweeps: AUTO,
+                sweeps: AUTO,
                 why: format!("event: {fast_why}; the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone would be swept, and without gravity nothing rests: the exact event-driven step flies the same events without the swept step's closing discrete pass"),
             }
         } else {
