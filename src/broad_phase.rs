@@ -1832,47 +1832,83 @@ mod tests {
         }
     }
 
-    /// A few fast objects among slow ones: with their strides known, their leads keep the list
-    /// (neither rebuilt nor mended) for several steps instead of one, and it still finds every
-    /// pair.
-    #[test]
-    fn fast_objects_led_by_their_strides_keep_the_list_and_miss_no_pair() {
+    /// 1,000 disks of radius 0.5 at random in a wrapped box 56 wide, each to move `speed(i)` a
+    /// step in a random direction: the box, the disks, each one's step and its length.
+    #[allow(clippy::type_complexity)]
+    fn drifting(
+        seed: u64,
+        speed: impl Fn(usize) -> f64,
+    ) -> (
+        Topology<DVec2>,
+        Vec<BroadObject<DVec2>>,
+        Vec<DVec2>,
+        Vec<f64>,
+    ) {
         let topo = Topology {
             min: DVec2::ZERO,
             max: DVec2::splat(56.0),
             border: Border::Wrap,
         };
-        let mut rng = Rng::new(9);
-        let mut objs = random_objs::<DVec2>(&mut rng, 1000, 55.0, 0.5, 0.5);
-        // One in 50 moves 0.33 a step (outrunning the half skin, 0.3, in one step), the rest
-        // 0.01 a step, in random directions.
+        let mut rng = Rng::new(seed);
+        let objs = random_objs::<DVec2>(&mut rng, 1000, 55.0, 0.5, 0.5);
         let steps: Vec<DVec2> = (0..objs.len())
             .map(|i| {
                 let a = rng.uniform(0.0, std::f64::consts::TAU);
-                DVec2::new(a.cos(), a.sin()) * if i % 50 == 0 { 0.33 } else { 0.01 }
+                DVec2::new(a.cos(), a.sin()) * speed(i)
             })
             .collect();
-        let strides: Vec<f64> = steps.iter().map(|d| d.length()).collect();
-        let (mut led, mut unled) = (
-            BroadPhase::new(BroadPhaseMode::Auto),
-            BroadPhase::new(BroadPhaseMode::Auto),
-        );
-        let turns = 64;
+        let strides = steps.iter().map(|d| d.length()).collect();
+        (topo, objs, steps, strides)
+    }
+
+    /// `turns` steps of the [`drifting`] disks: each step every phase finds the pairs, told the
+    /// given strides and whether it is in a crowd, and they must be brute force's.
+    fn drift(
+        topo: &Topology<DVec2>,
+        mut objs: Vec<BroadObject<DVec2>>,
+        steps: &[DVec2],
+        turns: usize,
+        phases: &mut [(&mut BroadPhase<DVec2>, &[f64], bool)],
+    ) {
         for step in 0..turns {
-            let expected = brute(&objs, &topo);
-            for (phase, strides) in [(&mut led, &strides[..]), (&mut unled, &[0.0; 1000][..])] {
+            let expected = brute(&objs, topo);
+            for (phase, strides, crowded) in phases.iter_mut() {
+                phase.set_crowded(*crowded);
                 let mut pairs = Vec::new();
                 let objects = Striding {
                     objs: &objs,
                     strides,
                 };
-                phase.find_pairs_in(&objects, &topo, &mut pairs, None);
-                assert_eq!(normalise(pairs), expected, "step {step}");
+                phase.find_pairs_in(&objects, topo, &mut pairs, None);
+                assert_eq!(normalise(pairs), expected, "step {step}, crowded {crowded}");
             }
-            for (o, d) in objs.iter_mut().zip(&steps) {
+            for (o, d) in objs.iter_mut().zip(steps) {
                 o.center = topo.wrap_position(o.center + *d);
             }
         }
+    }
+
+    /// A few fast objects among slow ones: with their strides known, their leads keep the list
+    /// (neither rebuilt nor mended) for several steps instead of one, and it still finds every
+    /// pair.
+    #[test]
+    fn fast_objects_led_by_their_strides_keep_the_list_and_miss_no_pair() {
+        // One in 50 moves 0.33 a step (outrunning the half skin, 0.3, in one step), the rest
+        // 0.01 a step, in random directions.
+        let (topo, objs, steps, strides) = drifting(9, |i| if i % 50 == 0 { 0.33 } else { 0.01 });
+        let (mut led, mut unled) = (
+            BroadPhase::new(BroadPhaseMode::Auto),
+            BroadPhase::new(BroadPhaseMode::Auto),
+        );
+        let turns = 64;
+        let none = [0.0; 1000];
+        drift(
+            &topo,
+            objs,
+            &steps,
+            turns,
+            &mut [(&mut led, &strides, false), (&mut unled, &none, false)],
+        );
         let changes = |b: &BroadPhase<DVec2>| b.rebuilds() + b.repairs();
         assert!(
             changes(&unled) >= turns as u64 - 1,
@@ -1899,41 +1935,19 @@ mod tests {
     /// every pair.
     #[test]
     fn outside_a_crowd_every_object_that_would_outrun_the_skin_is_led() {
-        let topo = Topology {
-            min: DVec2::ZERO,
-            max: DVec2::splat(56.0),
-            border: Border::Wrap,
-        };
-        let mut rng = Rng::new(11);
-        let mut objs = random_objs::<DVec2>(&mut rng, 1000, 55.0, 0.5, 0.5);
-        let steps: Vec<DVec2> = (0..objs.len())
-            .map(|i| {
-                let a = rng.uniform(0.0, std::f64::consts::TAU);
-                DVec2::new(a.cos(), a.sin()) * if i % 10 < 6 { 0.06 } else { 0.1 }
-            })
-            .collect();
-        let strides: Vec<f64> = steps.iter().map(|d| d.length()).collect();
+        let (topo, objs, steps, strides) = drifting(11, |i| if i % 10 < 6 { 0.06 } else { 0.1 });
         let (mut gas, mut crowd) = (
             BroadPhase::new(BroadPhaseMode::Auto),
             BroadPhase::new(BroadPhaseMode::Auto),
         );
         let turns = 64;
-        for step in 0..turns {
-            let expected = brute(&objs, &topo);
-            for (phase, crowded) in [(&mut gas, false), (&mut crowd, true)] {
-                phase.set_crowded(crowded);
-                let mut pairs = Vec::new();
-                let objects = Striding {
-                    objs: &objs,
-                    strides: &strides,
-                };
-                phase.find_pairs_in(&objects, &topo, &mut pairs, None);
-                assert_eq!(normalise(pairs), expected, "step {step}, crowded {crowded}");
-            }
-            for (o, d) in objs.iter_mut().zip(&steps) {
-                o.center = topo.wrap_position(o.center + *d);
-            }
-        }
+        drift(
+            &topo,
+            objs,
+            &steps,
+            turns,
+            &mut [(&mut gas, &strides, false), (&mut crowd, &strides, true)],
+        );
         let changes = |b: &BroadPhase<DVec2>| b.rebuilds() + b.repairs();
         let most = 2 * (turns as u64 / LEAD_STEPS as u64 + 1);
         assert!(
