@@ -1223,15 +1223,11 @@ impl<V: Vector> World<V> {
     /// The contacts and wall pairs in the order of their lower slot, then their higher one: the
     /// order the response takes them in, whatever order the broad phase found them in.
     fn sort_contacts(&mut self) {
-        let listed = self.broad.listed();
-        let crowded =
-            !self.contacts.is_empty() && LISTED_PER_CONTACT * self.contacts.len() >= listed;
+        let crowded = !self.contacts.is_empty()
+            && LISTED_PER_CONTACT * self.contacts.len() >= self.broad.listed();
         self.broad.set_crowded(crowded);
         let slots = self.critters.slot_count();
-        if !sort_pairs(&mut self.contacts, slots)
-            && self.contacts.len() >= RADIX_MIN
-            && LISTED_PER_CONTACT * self.contacts.len() >= self.broad.listed()
-        {
+        if !sort_pairs(&mut self.contacts, slots) && self.contacts.len() >= RADIX_MIN && crowded {
             self.broad.sort_list();
         }
         let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
