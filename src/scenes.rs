@@ -54,8 +54,8 @@ impl AnyWorld {
         both!(self, w => w.set_method(m))
     }
     /// What `auto` chose for the last step, and why.
-    pub fn auto_choice(&self) -> Option<(crate::method::Method, String)> {
-        both!(self, w => w.auto_choice().cloned())
+    pub fn auto_choice(&self) -> Option<(crate::method::Method, crate::method::auto::Why)> {
+        both!(self, w => w.auto_choice())
     }
     /// How many critters sleep (under `solve:n`, [`crate::method::sleep`]).
     pub fn sleepers(&self) -> usize {

@@ -260,7 +260,7 @@ pub struct World<V: Vector> {
     pub(crate) wall_pairs: Vec<(u32, u32, bool)>,
     pub(crate) method: Method,
     /// What `auto` chose for the last step, and why.
-    pub(crate) auto_choice: Option<(Method, String)>,
+    pub(crate) auto_choice: Option<(Method, crate::method::auto::Why)>,
     pub(crate) flight: crate::method::flight::Scratch<V>,
     pub(crate) solve: crate::method::solve::Scratch<V>,
     /// Who sleeps under `solve:n` ([`crate::method::sleep`]).
@@ -359,9 +359,10 @@ impl<V: Vector> World<V> {
         self.method = m;
         Ok(())
     }
-    /// For `auto`: the method chosen for the last step and the reason (None for other methods).
-    pub fn auto_choice(&self) -> Option<&(Method, String)> {
-        self.auto_choice.as_ref()
+    /// For `auto`: the method chosen for the last step and the reason, written out by its
+    /// `Display` (None for other methods).
+    pub fn auto_choice(&self) -> Option<(Method, crate::method::auto::Why)> {
+        self.auto_choice
     }
     /// Gravity.
     pub fn gravity(&self) -> V {

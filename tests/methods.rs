@@ -735,7 +735,7 @@ fn dropped_heap(method: Method) -> (World<DVec2>, usize) {
     let mut substeps = 0;
     for _ in 0..360 {
         w.step().unwrap();
-        let why = w.auto_choice().map_or("", |c| c.1.as_str());
+        let why = w.auto_choice().map_or(String::new(), |c| c.1.to_string());
         substeps += usize::from(why.contains("substeps"));
     }
     (w, substeps)

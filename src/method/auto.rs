@@ -84,7 +84,89 @@ pub struct Choice {
     /// Sweeps of a solved step.
     pub sweeps: Sweeps,
     /// Why, for `critterbox run`.
-    pub why: String,
+    pub why: Why,
+}
+
+/// Why `auto` took its method: the figures it decided on. It is written out only when asked
+/// (`Display`), since formatting them every step would cost a small scene a fifth of its step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Why {
+    /// Solved under gravity, in `substeps` substeps.
+    Solve {
+        /// The largest [`tunnel_fraction`] of the step.
+        tunnel: f64,
+        /// The substeps that keep each under [`SOLVE_FRACTION`].
+        substeps: u32,
+        /// Critters asleep when the step began.
+        asleep: usize,
+    },
+    /// Discrete: nobody moves far enough to tunnel.
+    Discrete {
+        /// The largest displacement of a disk in the step.
+        fastest: f64,
+        /// The smallest radius or wall thickness.
+        smallest: f64,
+    },
+    /// Swept or event: someone moves far enough to tunnel.
+    Fast {
+        /// The largest displacement of a disk in the step.
+        fastest: f64,
+        /// The smallest radius or wall thickness.
+        smallest: f64,
+        /// Disks that move more than [`SWEEP_FRACTION`] of `smallest`.
+        fast: usize,
+        /// All disks.
+        all: usize,
+        /// The fraction of the box the disks cover.
+        packing: f64,
+        /// Without gravity and dense: the event step, which flies the swept step's events.
+        event: bool,
+    },
+}
+
+impl std::fmt::Display for Why {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Why::Solve {
+                tunnel,
+                substeps,
+                asleep,
+            } => {
+                write!(f, "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; ")?;
+                match substeps {
+                    1 => write!(f, "no critter moves more than {tunnel:.3e} of what would carry it through a wall or a disk (under {SOLVE_FRACTION})")?,
+                    k => write!(f, "the fastest critter moves {tunnel:.3e} of what would carry it through a wall or a disk, so the step is cut into {k} substeps of under {SOLVE_FRACTION} each")?,
+                }
+                write!(
+                    f,
+                    "; a pile more than {deep} contacts deep gets one sweep more per {per} layers (up to {AUTO_MOST_SWEEPS}), as its weight needs; {asleep} asleep",
+                    deep = AUTO_SWEEPS * LAYERS_PER_SWEEP,
+                    per = LAYERS_PER_SWEEP,
+                )
+            }
+            Why::Discrete { fastest, smallest } => write!(
+                f,
+                "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
+            ),
+            Why::Fast {
+                fastest,
+                smallest,
+                fast,
+                all,
+                packing: phi,
+                event,
+            } => {
+                let fast_why = format!("the fastest critter moves {fastest:.3e} per step, more than {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete could tunnel; {fast} of {all} critters move that far");
+                if event {
+                    write!(f, "event: {fast_why}; the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone would be swept, and without gravity nothing rests: the exact event-driven step flies the same events without the swept step's closing discrete pass")
+                } else if phi < SPARSE {
+                    write!(f, "swept: {fast_why}; the disks cover {phi:.3} of the box (under {SPARSE}), so the slow ones are swept only where something is within reach")
+                } else {
+                    write!(f, "swept: {fast_why}; the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone is swept")
+                }
+            }
+        }
+    }
 }
 
 /// A step under gravity is solved in as many substeps as keep each substep's
@@ -122,21 +204,16 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
     if falling && tunnel <= SOLVE_FRACTION * f64::from(MOST_SOLVE_SUBSTEPS) {
         // Integer-valued and from 1 to MOST_SOLVE_SUBSTEPS: the cast is exact.
         let substeps = (tunnel / SOLVE_FRACTION).ceil().max(1.0) as u32;
-        let how = match substeps {
-            1 => format!("no critter moves more than {tunnel:.3e} of what would carry it through a wall or a disk (under {SOLVE_FRACTION})"),
-            k => format!("the fastest critter moves {tunnel:.3e} of what would carry it through a wall or a disk, so the step is cut into {k} substeps of under {SOLVE_FRACTION} each"),
-        };
         Choice {
             method: Method::Solve(AUTO_SWEEPS),
             per_critter: false,
             substeps,
             sweeps: AUTO,
-            why: format!(
-                "solve:{AUTO_SWEEPS}: under gravity critters come to rest on each other, and the discrete step would let them sink into each other; {how}; a pile more than {deep} contacts deep gets one sweep more per {per} layers (up to {AUTO_MOST_SWEEPS}), as its weight needs; {asleep} asleep",
-                deep = AUTO_SWEEPS * LAYERS_PER_SWEEP,
-                per = LAYERS_PER_SWEEP,
-                asleep = world.sleepers()
-            ),
+            why: Why::Solve {
+                tunnel,
+                substeps,
+                asleep: world.sleepers(),
+            },
         }
     } else if fastest <= limit {
         Choice {
@@ -144,38 +221,71 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
             per_critter: false,
             substeps: 1,
             sweeps: AUTO,
-            why: format!(
-                "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
-            ),
+            why: Why::Discrete { fastest, smallest },
         }
     } else {
         let (fast, all) = count_fast(world, limit);
         let phi = packing(world);
         let per_critter = phi < SPARSE;
-        let slow = if per_critter {
-            format!("the disks cover {phi:.3} of the box (under {SPARSE}), so the slow ones are swept only where something is within reach")
-        } else {
-            format!("the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone is swept")
-        };
-        let fast_why = format!("the fastest critter moves {fastest:.3e} per step, more than {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete could tunnel; {fast} of {all} critters move that far");
-        if !falling && !per_critter {
-            // Everyone would be swept, and nothing rests: the event-driven step flies the same
-            // events without the swept step's closing discrete pass.
-            Choice {
-                method: Method::Event,
-                per_critter: false,
-                substeps: 1,
-                sweeps: AUTO,
-                why: format!("event: {fast_why}; the disks cover {phi:.3} of the box ({SPARSE} or more), so everyone would be swept, and without gravity nothing rests: the exact event-driven step flies the same events without the swept step's closing discrete pass"),
-            }
-        } else {
-            Choice {
-                method: Method::Swept,
-                per_critter,
-                substeps: 1,
-                sweeps: AUTO,
-                why: format!("swept: {fast_why}; {slow}"),
-            }
+        // Without gravity in a dense scene everyone would be swept, and nothing rests: the
+        // event-driven step flies the same events without the swept step's closing discrete
+        // pass.
+        let event = !falling && !per_critter;
+        Choice {
+            method: if event { Method::Event } else { Method::Swept },
+            per_critter,
+            substeps: 1,
+            sweeps: AUTO,
+            why: Why::Fast {
+                fastest,
+                smallest,
+                fast,
+                all,
+                packing: phi,
+                event,
+            },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each reason names its method and the figures it was decided on, as `critterbox run`
+    /// prints them.
+    #[test]
+    fn each_reason_names_its_method_and_its_figures() {
+        let solve = Why::Solve {
+            tunnel: 1.25,
+            substeps: 3,
+            asleep: 7,
+        }
+        .to_string();
+        assert!(solve.starts_with("solve:8: "), "{solve}");
+        assert!(solve.contains("1.250e0") && solve.contains("cut into 3 substeps"));
+        assert!(solve.ends_with("7 asleep"), "{solve}");
+        let discrete = Why::Discrete {
+            fastest: 1.78e-3,
+            smallest: 0.2,
+        }
+        .to_string();
+        assert!(discrete.starts_with("discrete: "), "{discrete}");
+        assert!(discrete.contains("1.780e-3") && discrete.contains("(2.000e-1)"));
+        let fast = |packing, event| {
+            Why::Fast {
+                fastest: 0.5,
+                smallest: 0.2,
+                fast: 3,
+                all: 10,
+                packing,
+                event,
+            }
+            .to_string()
+        };
+        assert!(fast(0.3, true).starts_with("event: "));
+        assert!(fast(0.3, false).contains("so everyone is swept"));
+        assert!(fast(0.01, false).contains("swept only where something is within reach"));
+        assert!(fast(0.3, true).contains("3 of 10 critters"));
     }
 }
