@@ -215,6 +215,12 @@ pub(crate) struct Scratch<V> {
     least_rmax: f64,
     /// Slower critters predict at the flight's start only if they may meet something (`run`).
     fast: Option<f64>,
+    /// With `fast`, at the flight's start: how far each critter can move in it (`reach`), and
+    /// whether it may meet something (`may_meet`, found by `mark_who_may_meet`).
+    reach: Vec<f64>,
+    meets: Vec<bool>,
+    /// Per cell: a wall is listed in the cell or one around it.
+    near_wall: Vec<bool>,
     /// Cells only, even where shells would pay (tests compare the two).
     #[cfg(test)]
     no_shells: bool,
@@ -313,12 +319,19 @@ fn fly<V: Vector>(
 ) -> Result<Flight, Error> {
     setup(w, sc, acc, t_end);
     let n = w.critters.slot_count() as u32;
-    for a in 0..n {
-        if sc
-            .fast
-            .is_none_or(|limit| reach(sc, a) > limit || may_meet(w, sc, a))
-        {
-            predict_all(w, sc, a, 0.0)?;
+    match sc.fast {
+        Some(limit) => {
+            mark_who_may_meet(w, sc);
+            for a in 0..n {
+                if sc.reach[a as usize] > limit || sc.meets[a as usize] {
+                    predict_all(w, sc, a, 0.0)?;
+                }
+            }
+        }
+        None => {
+            for a in 0..n {
+                predict_all(w, sc, a, 0.0)?;
+            }
         }
     }
     let mut processed = 0u64;
@@ -512,10 +525,20 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     for axis in 0..dim {
         dims[axis] = ((size.get(axis) / want).floor() as usize).clamp(1, 1 << 20);
     }
+    // Over the cap, every axis is scaled down by one factor to just under it (halving every
+    // axis, as before, could leave a quarter of the cap in 2D and an eighth in 3D: cells twice
+    // as wide as needed, four or eight times the candidates per prediction).
     let cap = (2 * disks).max(27);
-    while dims[..dim].iter().product::<usize>() > cap {
+    let total = dims[..dim].iter().product::<usize>();
+    if total > cap {
+        let scale = (cap as f64 / total as f64).powf(1.0 / dim as f64);
         for d in dims[..dim].iter_mut() {
-            *d = (*d).div_ceil(2).max(1);
+            *d = ((*d as f64 * scale).floor() as usize).max(1);
+        }
+        // Round-off in the scale: take one cell off the widest axis until under the cap.
+        while dims[..dim].iter().product::<usize>() > cap {
+            let widest = (0..dim).max_by_key(|&ax| dims[ax]).unwrap_or(0);
+            dims[widest] = (dims[widest] - 1).max(1);
         }
     }
     for axis in 0..3 {
@@ -622,38 +645,21 @@ fn reach<V: Vector>(sc: &Scratch<V>, a: u32) -> f64 {
 /// Whether slow critter `a` may meet anything in the flight if nobody's flight changes: a disk,
 /// a wall or a bounding border within reach of both. (A critter that meets nothing needs no
 /// prediction until a collision changes a flight, and then the changed critter predicts.)
+/// The flight asks [`mark_who_may_meet`], which gives the same answers pair by pair; this is
+/// its definition, which the tests compare it with.
+#[cfg(test)]
 fn may_meet<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32) -> bool {
     let body = sc.body[a as usize];
     if body.radius.is_nan() {
         return false;
     }
     let mine = reach(sc, a);
-    if w.topo.border != Border::Wrap {
-        for axis in 0..V::DIM {
-            let x = body.pos.get(axis);
-            let room = (x - w.topo.min.get(axis)).min(w.topo.max.get(axis) - x);
-            if room <= body.radius + mine {
-                return true;
-            }
-        }
+    if near_border(w, body, mine) || (sc.has_walls && near_a_wall(w, sc, a, mine)) {
+        return true;
     }
     let mut around = [0usize; 27];
     let count = cells_around(w, sc, a, &mut around);
     for &k in &around[..count] {
-        if sc.has_walls {
-            for &x in &sc.cell_walls[k] {
-                let Some(c) = w.critters.slot(x) else {
-                    continue;
-                };
-                let Shape::Wall(wall) = &c.shape else {
-                    continue;
-                };
-                let d = w.topo.delta(c.pos, body.pos);
-                if c.alive && contact_wall_ball(wall, d, body.radius + mine).is_some() {
-                    return true;
-                }
-            }
-        }
         for &b in sc.cells.members(k) {
             let other = sc.body[b as usize];
             if b == a || other.radius.is_nan() {
@@ -666,6 +672,140 @@ fn may_meet<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32) -> bool {
         }
     }
     false
+}
+
+/// Whether a disk `body` that moves up to `mine` may reach a bounding border.
+#[inline]
+fn near_border<V: Vector>(w: &World<V>, body: Body<V>, mine: f64) -> bool {
+    if w.topo.border == Border::Wrap {
+        return false;
+    }
+    (0..V::DIM).any(|axis| {
+        let x = body.pos.get(axis);
+        let room = (x - w.topo.min.get(axis)).min(w.topo.max.get(axis) - x);
+        room <= body.radius + mine
+    })
+}
+
+/// Whether disk `a`, moving up to `mine`, may reach a wall listed in the cells around its own.
+fn near_a_wall<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, mine: f64) -> bool {
+    let body = sc.body[a as usize];
+    let mut around = [0usize; 27];
+    let count = cells_around(w, sc, a, &mut around);
+    for &k in &around[..count] {
+        for &x in &sc.cell_walls[k] {
+            let Some(c) = w.critters.slot(x) else {
+                continue;
+            };
+            let Shape::Wall(wall) = &c.shape else {
+                continue;
+            };
+            let d = w.topo.delta(c.pos, body.pos);
+            if c.alive && contact_wall_ball(wall, d, body.radius + mine).is_some() {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Fills `sc.reach` and `sc.meets` at the flight's start: `meets[a]` is exactly `may_meet(a)`,
+/// found pair by pair over the cells instead of critter by critter (each pair of neighbouring
+/// cells read once, in cell order, each pair of disks tested once for both of its disks, each
+/// side with `may_meet`'s own arithmetic), and the walls asked only by disks whose cell has a
+/// wall around it.
+fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
+    let n = sc.body.len();
+    let mut reaches = std::mem::take(&mut sc.reach);
+    reaches.clear();
+    reaches.extend((0..n as u32).map(|a| reach(sc, a)));
+    let mut meets = std::mem::take(&mut sc.meets);
+    meets.clear();
+    meets.resize(n, false);
+    let dims = sc.dims;
+    let total: usize = dims[..V::DIM].iter().product();
+    let mut near_wall = std::mem::take(&mut sc.near_wall);
+    near_wall.clear();
+    near_wall.resize(total, false);
+    let mut around = [0usize; 27];
+    if sc.has_walls {
+        for k in 0..total {
+            if !sc.cell_walls[k].is_empty() {
+                let count = cells_around_cell(w, sc, coords(&dims, k), &mut around);
+                for &j in &around[..count] {
+                    near_wall[j] = true;
+                }
+            }
+        }
+    }
+    for a in 0..n {
+        let body = sc.body[a];
+        if body.radius.is_nan() {
+            continue;
+        }
+        let mine = reaches[a];
+        meets[a] = near_border(w, body, mine)
+            || (near_wall[sc.cell[a] as usize] && near_a_wall(w, sc, a as u32, mine));
+    }
+    // Disks in neighbouring cells. Cells off the grid's edges pair with the cells after them
+    // (half the offsets, each pair of cells once); the others with every cell around them.
+    let forward: Vec<isize> = sc.offsets.iter().copied().filter(|&o| o > 0).collect();
+    let mut pair = |a: u32, b: u32| {
+        let (ba, bb) = (sc.body[a as usize], sc.body[b as usize]);
+        if ba.radius.is_nan() || bb.radius.is_nan() {
+            return;
+        }
+        let (ra, rb) = (reaches[a as usize], reaches[b as usize]);
+        // `delta` is odd in its arguments bit for bit, so one squared distance serves both.
+        let d2 = w.topo.delta(ba.pos, bb.pos).length_squared();
+        let near_a = ba.radius + bb.radius + ra + rb;
+        let near_b = bb.radius + ba.radius + rb + ra;
+        if d2 <= near_a * near_a {
+            meets[a as usize] = true;
+        }
+        if d2 <= near_b * near_b {
+            meets[b as usize] = true;
+        }
+    };
+    // The cells in key order, their coordinates counted along (no divisions).
+    let cells = (0..dims[2]).flat_map(|z| {
+        (0..dims[1]).flat_map(move |y| (0..dims[0]).map(move |x| [x as i64, y as i64, z as i64]))
+    });
+    for (k, hc) in cells.enumerate() {
+        let mine = sc.cells.members(k);
+        if mine.is_empty() {
+            continue;
+        }
+        if interior_at::<V>(sc, hc) {
+            for (i, &a) in mine.iter().enumerate() {
+                for &b in &mine[i + 1..] {
+                    pair(a, b);
+                }
+            }
+            for &o in &forward {
+                let theirs = sc.cells.members((k as isize + o) as usize);
+                for &a in mine {
+                    for &b in theirs {
+                        pair(a, b);
+                    }
+                }
+            }
+        } else {
+            let count = cells_around_cell(w, sc, hc, &mut around);
+            for &j in &around[..count] {
+                for &a in mine {
+                    for &b in sc.cells.members(j) {
+                        if a != b {
+                            pair(a, b);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    sc.reach = reaches;
+    sc.meets = meets;
+    sc.near_wall = near_wall;
 }
 
 /// Lists every pair whose shells overlap (at the start of a flight, every shell is centred on
@@ -726,8 +866,18 @@ fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usi
         }
         return sc.offsets.len();
     }
+    cells_around_cell(w, sc, sc.coord[a as usize], out)
+}
+
+/// [`cells_around`] the cell at coordinates `hc`, by the general path (wrapped or cut at the
+/// grid's edges, each once).
+fn cells_around_cell<V: Vector>(
+    w: &World<V>,
+    sc: &Scratch<V>,
+    hc: [i64; 3],
+    out: &mut [usize; 27],
+) -> usize {
     let dims = sc.dims;
-    let hc = sc.coord[a as usize];
     let mut count = 0;
     let span = |axis: usize| if axis < V::DIM { -1..=1 } else { 0..=0 };
     for dz in span(2) {
@@ -1086,7 +1236,12 @@ fn predict_after_crossing<V: Vector>(
 /// wrapping, no repeats).
 #[inline]
 fn interior<V: Vector>(sc: &Scratch<V>, a: u32) -> bool {
-    let hc = sc.coord[a as usize];
+    interior_at::<V>(sc, sc.coord[a as usize])
+}
+
+/// Whether the cell at coordinates `hc` is off the grid's edges.
+#[inline]
+fn interior_at<V: Vector>(sc: &Scratch<V>, hc: [i64; 3]) -> bool {
     !sc.offsets.is_empty() && (0..V::DIM).all(|ax| hc[ax] >= 1 && hc[ax] + 2 <= sc.dims[ax] as i64)
 }
 
@@ -1653,6 +1808,133 @@ mod tests {
             .map(|(a, b)| topo.delta(a.pos, b.pos).length())
             .fold(0.0, f64::max);
         assert!(worst < 1e-9, "spheres differ by {worst:e}");
+    }
+
+    /// The flight's start asks who may meet something pair by pair over the cells
+    /// (`mark_who_may_meet`); the answers are `may_meet`'s, critter by critter, for every disk:
+    /// walled and periodic gases in 2D and 3D, stirred so that some disks are close and some
+    /// fast, a wall across the middle, and a box too thin for three cells across.
+    #[test]
+    fn who_may_meet_pair_by_pair_is_may_meet() {
+        fn check<V: crate::Vector>(border: Border, n: usize, packing: f64, thin: bool) {
+            let mut w = if thin {
+                // A periodic box 1.5 across but along the first axis: one cell across.
+                let mut hi = V::splat(1.5);
+                hi.set(0, 1.3 * n as f64);
+                let config = crate::WorldConfig::new(V::zero(), hi)
+                    .border(border)
+                    .dt(1.0 / 60.0);
+                let mut w = World::new(config).expect("the world builds");
+                for i in 0..n {
+                    let mut p = V::splat(0.75);
+                    p.set(0, 1.3 * i as f64 + 0.2 * ((i * 7) % 5) as f64);
+                    let mut v = V::zero();
+                    v.set(0, if i % 2 == 0 { 1.0 } else { -0.7 });
+                    w.spawn(crate::CritterSpec::ball(p).vel(v).radius(0.5))
+                        .expect("spawns");
+                }
+                w
+            } else {
+                gas::<V>(&GasParams {
+                    n,
+                    packing,
+                    dt: 1.0 / 60.0,
+                    border,
+                    seed: 11,
+                    ..GasParams::default()
+                })
+                .expect("the gas builds")
+            };
+            if border != Border::Wrap {
+                let (lo, hi) = (w.topo.min, w.topo.max);
+                let mid = (lo + hi) * 0.5;
+                let mut a = mid;
+                a.set(0, lo.get(0) + 2.0);
+                let mut b = mid;
+                b.set(0, hi.get(0) - 2.0);
+                let half = V::splat(0.05);
+                w.add_wall(crate::WallBox::aligned(a - half, b + half).expect("a box"))
+                    .expect("the wall goes in");
+            }
+            // Stir: a few discrete steps at speeds of several radii per second, then some disks
+            // much faster.
+            let ids: Vec<_> = w
+                .critters()
+                .iter()
+                .filter(|c| !c.is_wall())
+                .map(|c| c.id())
+                .collect();
+            for (i, id) in ids.iter().enumerate() {
+                let c = w.get_mut(*id).expect("live");
+                c.vel = c.vel * if i % 13 == 0 { 40.0 } else { 6.0 };
+            }
+            for _ in 0..20 {
+                w.step().expect("steps");
+            }
+            let limit = 0.25 * 0.5;
+            let mut sc = std::mem::take(&mut w.flight);
+            sc.fast = Some(limit);
+            let dt = w.dt;
+            super::setup(&mut w, &mut sc, V::zero(), dt);
+            super::mark_who_may_meet(&w, &mut sc);
+            let (mut yes, mut no) = (0, 0);
+            for a in 0..sc.body.len() as u32 {
+                let want = super::may_meet(&w, &sc, a);
+                assert_eq!(sc.meets[a as usize], want, "disk {a}");
+                if sc.body[a as usize].radius.is_nan() {
+                    continue;
+                }
+                if want {
+                    yes += 1;
+                } else {
+                    no += 1;
+                }
+            }
+            assert!(
+                yes * 20 > n && no * 20 > n,
+                "{yes} may meet, {no} not: too one-sided"
+            );
+        }
+        check::<glam::DVec2>(Border::Bounce, 3000, 0.15, false);
+        check::<glam::DVec2>(Border::Wrap, 3000, 0.15, false);
+        check::<glam::DVec2>(Border::Wrap, 200, 0.0, true);
+        check::<DVec3>(Border::Bounce, 2000, 0.1, false);
+        check::<DVec3>(Border::Wrap, 2000, 0.1, false);
+    }
+
+    /// Cells are at least a diameter wide and at most about two per disk: over that cap the
+    /// grid is scaled down to just under it, not halved (which could leave a quarter of the
+    /// cap in 2D and an eighth in 3D, cells twice as wide as needed).
+    #[test]
+    fn cells_come_as_close_to_their_cap_as_a_diameter_allows() {
+        fn check<V: crate::Vector>(n: usize, packing: f64) {
+            let mut w = gas::<V>(&GasParams {
+                n,
+                packing,
+                ..GasParams::default()
+            })
+            .expect("the gas builds");
+            let mut sc = std::mem::take(&mut w.flight);
+            let dt = w.dt;
+            super::setup(&mut w, &mut sc, V::zero(), dt);
+            let total: usize = sc.dims[..V::DIM].iter().product();
+            let cap = 2 * n;
+            let widest = (w.topo.size().get(0) / 1.0).floor() as usize;
+            let unconstrained = widest.pow(V::DIM as u32);
+            assert!(total <= cap, "{total} cells for {n} disks");
+            assert!(
+                10 * total >= 7 * cap.min(unconstrained),
+                "{total} cells for {n} disks (cap {cap}, {unconstrained} a diameter wide)"
+            );
+            for axis in 0..V::DIM {
+                assert!(sc.side[axis] >= 1.0, "cells {} wide", sc.side[axis]);
+            }
+        }
+        check::<glam::DVec2>(100, 0.3);
+        check::<glam::DVec2>(10_000, 0.02);
+        check::<glam::DVec2>(10_000, 0.4);
+        check::<DVec3>(1000, 0.2);
+        check::<DVec3>(4000, 0.05);
     }
 
     /// Shells keep the gas exact: energy and momentum conserved, nobody overlapping.
