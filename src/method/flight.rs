@@ -34,7 +34,7 @@ use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
 use crate::method::pair_key;
 use crate::method::queue::{Owned, Queue};
-use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_wall_ball};
+use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_ball_ball_by, toi_wall_ball};
 use crate::rules::PairRule;
 use crate::vector::Vector;
 use crate::world::{at_step, roles_order, StepStats, World};
@@ -577,9 +577,10 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     load.resize(total, 0);
     for c in w.critters.iter() {
         if c.alive && !c.is_wall() {
-            let k = cell_of(w, sc, c.pos);
+            let (k, cc) = cell_of(w, sc, c.pos);
+            debug_assert_eq!(coords(&dims, k), cc, "cell {k}'s coordinates");
             sc.cell[c.id.index as usize] = k as u32;
-            sc.coord[c.id.index as usize] = coords(&dims, k);
+            sc.coord[c.id.index as usize] = cc;
             load[k] += 1;
         }
     }
@@ -924,8 +925,8 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
         }
     }
     sc.center[ai] = p;
-    let new = cell_of(w, sc, p);
-    move_cell(sc, a, old, new);
+    let (new, cc) = cell_of(w, sc, p);
+    move_cell(sc, a, old, new, cc);
     let mut around = [0usize; 27];
     let count = cells_around(w, sc, a, &mut around);
     for &k in &around[..count] {
@@ -990,13 +991,15 @@ fn coords(dims: &[usize; 3], k: usize) -> [i64; 3] {
     ]
 }
 
-fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> usize {
+/// The cell of position `p`: its key and its coordinates (kept beside the key, which would
+/// take three divisions to unpack).
+fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) {
     let mut c = [0i64; 3];
     for (axis, ca) in c.iter_mut().enumerate().take(V::DIM) {
         let x = ((p.get(axis) - w.topo.min.get(axis)) / sc.side[axis]).floor() as i64;
         *ca = x.clamp(0, sc.dims[axis] as i64 - 1);
     }
-    key(&sc.dims, c)
+    (key(&sc.dims, c), c)
 }
 
 /// Copies critter `a` into its body (after the flight or a hook changed it).
@@ -1288,7 +1291,8 @@ fn predict_disk<V: Vector>(
     let s = if d.length_squared() < r * r {
         0.0 // overlapping: collide now (approaching or not)
     } else {
-        match toi_ball_ball(d, vb - va, r) {
+        // Contacts past the horizon are dropped below; most are found so without a root.
+        match toi_ball_ball_by(d, vb - va, r, horizon) {
             Some(s) => s,
             None => return Ok(()),
         }
@@ -1635,27 +1639,33 @@ fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32
     advance(w, sc, a, t);
     let (axis, dir) = ((tag / 2) as usize, tag % 2);
     let old = sc.cell[a as usize] as usize;
-    let mut cc = coords(&sc.dims, old);
+    let mut cc = sc.coord[a as usize];
     cc[axis] += if dir == 1 { 1 } else { -1 };
     let n = sc.dims[axis] as i64;
-    if w.topo.wraps() && (cc[axis] < 0 || cc[axis] >= n) {
-        let len = w.topo.size().get(axis);
-        let c = w.critters.slot_mut_moving(a).expect("live slot");
-        let x = c.pos.get(axis);
-        c.pos.set(axis, if dir == 1 { x - len } else { x + len });
+    if cc[axis] < 0 || cc[axis] >= n {
+        if w.topo.wraps() {
+            let len = w.topo.size().get(axis);
+            let c = w.critters.slot_mut_moving(a).expect("live slot");
+            let x = c.pos.get(axis);
+            c.pos.set(axis, if dir == 1 { x - len } else { x + len });
+        }
+        // Onto the grid's other side, as `key` takes it.
+        cc[axis] = cc[axis].rem_euclid(n);
     }
     let new = key(&sc.dims, cc);
-    move_cell(sc, a, old, new);
+    move_cell(sc, a, old, new, cc);
 }
 
-fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize) {
+/// Moves `a` from cell `old` to cell `new`, at coordinates `cc`.
+fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize, cc: [i64; 3]) {
     if old == new {
         return;
     }
     sc.cells.remove(old, a);
     sc.cells.push(new, a);
+    debug_assert_eq!(coords(&sc.dims, new), cc, "cell {new}'s coordinates");
     sc.cell[a as usize] = new as u32;
-    sc.coord[a as usize] = coords(&sc.dims, new);
+    sc.coord[a as usize] = cc;
 }
 
 /// After a hook ran: the critter may have died or been moved; put it in the right cell.
@@ -1684,8 +1694,8 @@ fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
         p = w.topo.wrap_position(p);
         w.critters.slot_mut_moving(a).expect("live").pos = p;
     }
-    let new = cell_of(w, sc, p);
-    move_cell(sc, a, old, new);
+    let (new, cc) = cell_of(w, sc, p);
+    move_cell(sc, a, old, new, cc);
 }
 
 /// Hands a touching pair to the caller's `collide` hook (Pop's roles), with the TC model.
