@@ -13,21 +13,8 @@ use crate::wall::WallBox;
 /// `r_sum` apart: the smaller root of `|d + w s|^2 = r_sum^2`.
 #[inline]
 pub fn toi_ball_ball<V: Vector>(d: V, w: V, r_sum: f64) -> Option<f64> {
-    let b = d.dot(w);
-    if b >= 0.0 {
-        return None; // not approaching
-    }
-    let c = d.length_squared() - r_sum * r_sum;
-    if c <= 0.0 {
-        return Some(0.0);
-    }
-    let a = w.length_squared();
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return None;
-    }
-    // c / (-b + sqrt(disc)) is the smaller root without cancellation.
-    Some(c / (-b + disc.sqrt()))
+    // No horizon: the early test never applies (its bound is infinite).
+    toi_ball_ball_by(d, w, r_sum, f64::INFINITY)
 }
 
 /// [`toi_ball_ball`] for a caller that only wants a contact by `horizon`: `None` early, without
@@ -58,6 +45,7 @@ pub fn toi_ball_ball_by<V: Vector>(d: V, w: V, r_sum: f64, horizon: f64) -> Opti
     if disc < 0.0 {
         return None;
     }
+    // c / (-b + sqrt(disc)) is the smaller root without cancellation.
     Some(c / (-b + disc.sqrt()))
 }
 
