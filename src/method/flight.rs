@@ -239,6 +239,9 @@ pub(crate) struct Scratch<V> {
     /// Key offsets of the 3^D cells around an interior cell (none when an axis has fewer than
     /// three cells: neighbours then repeat, and the general path dedups them).
     offsets: Vec<isize>,
+    /// The positive ones among `offsets`: the cells after an interior cell, with which
+    /// `mark_who_may_meet` pairs it (each pair of neighbouring cells once).
+    forward: Vec<isize>,
     /// Per axis and direction (`axis * 2 + dir`), the offsets among `offsets` of the cells a
     /// crossing that way brings into reach.
     front: [Vec<isize>; 6],
@@ -550,6 +553,7 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     }
     sc.dims = dims;
     sc.offsets.clear();
+    sc.forward.clear();
     sc.front.iter_mut().for_each(Vec::clear);
     sc.best.clear();
     sc.best.resize(n, None);
@@ -561,6 +565,9 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
                 for dx in reach(0) {
                     let o = dx + nx * dy + nxy * dz;
                     sc.offsets.push(o);
+                    if o > 0 {
+                        sc.forward.push(o);
+                    }
                     for (axis, d) in [dx, dy, dz].into_iter().enumerate() {
                         if d != 0 {
                             sc.front[axis * 2 + usize::from(d > 0)].push(o);
@@ -749,8 +756,7 @@ fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
             || (near_wall[sc.cell[a] as usize] && near_a_wall(w, sc, a as u32, mine));
     }
     // Disks in neighbouring cells. Cells off the grid's edges pair with the cells after them
-    // (half the offsets, each pair of cells once); the others with every cell around them.
-    let forward: Vec<isize> = sc.offsets.iter().copied().filter(|&o| o > 0).collect();
+    // (`forward`, each pair of cells once); the others with every cell around them.
     let mut pair = |a: u32, b: u32| {
         let (ba, bb) = (sc.body[a as usize], sc.body[b as usize]);
         if ba.radius.is_nan() || bb.radius.is_nan() {
@@ -783,7 +789,7 @@ fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
                     pair(a, b);
                 }
             }
-            for &o in &forward {
+            for &o in &sc.forward {
                 let theirs = sc.cells.members((k as isize + o) as usize);
                 for &a in mine {
                     for &b in theirs {
