@@ -1696,7 +1696,7 @@ const MOVE_AHEAD: usize = 4;
 
 /// A hint to start loading `slot`'s first cache line (nothing for `None`).
 #[inline]
-fn prefetch<T>(slot: Option<&T>) {
+pub(crate) fn prefetch<T>(slot: Option<&T>) {
     #[cfg(target_arch = "x86_64")]
     if let Some(slot) = slot {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};

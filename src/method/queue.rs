@@ -168,6 +168,19 @@ impl<E: Owned> Queue<E> {
         }
     }
 
+    /// The event after the earliest among those in the heap, if the heap holds two: most often
+    /// the next one to come up (a hint for what to load early; the earliest's new prediction
+    /// may still come first).
+    #[inline]
+    pub fn runner_up(&self) -> Option<E> {
+        let k = match self.heap.keys.get(1..3)? {
+            [l] => *l,
+            [l, r] => (*l).min(*r),
+            _ => return None,
+        };
+        self.events[owner_of(k) as usize]
+    }
+
     /// Takes the earliest event out of the queue.
     #[cfg(test)]
     pub fn pop(&mut self) -> Option<E> {
@@ -392,6 +405,21 @@ mod tests {
                             .values()
                             .min_by(|x, y| x.t.total_cmp(&y.t).then(x.a.cmp(&y.a)))
                             .copied();
+                        // The runner-up is a pending event after the earliest; with no
+                        // span (everything in the heap) it is the second earliest.
+                        let order = |x: &E, y: &E| x.t.total_cmp(&y.t).then(x.a.cmp(&y.a));
+                        if q.peek().is_some() {
+                            let up = q.runner_up();
+                            if let (Some(r), Some(w)) = (up, want) {
+                                assert_eq!(model.get(&r.a), Some(&r), "a pending event");
+                                assert_eq!(order(&w, &r), std::cmp::Ordering::Less);
+                            }
+                            if end == start {
+                                let mut all: Vec<E> = model.values().copied().collect();
+                                all.sort_by(order);
+                                assert_eq!(up, all.get(1).copied(), "the second earliest");
+                            }
+                        }
                         if let Some(w) = want {
                             model.remove(&w.a);
                             now = w.t;
