@@ -116,8 +116,10 @@ struct Body<V> {
     radius: f64,
 }
 
-/// The rest of what the flight knows about a critter.
+/// The rest of what the flight knows about a critter (16 bytes: one never straddles two
+/// cache lines).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(align(16))]
 struct Meta {
     /// Accelerates with the flight's gravity (free disks).
     free: bool,
@@ -125,6 +127,9 @@ struct Meta {
     wall: bool,
     /// The critter's rule class (pair rules are looked up by class).
     class: u32,
+    /// How many times its flight has changed (collisions, bounces): an event predicted with
+    /// another count is stale. Kept here, beside what a validity check reads anyway.
+    count: u32,
 }
 
 /// The critters in each cell, stored flat: cell `k` owns `data[k * stride..(k + 1) * stride]`,
@@ -193,7 +198,6 @@ impl Cells {
 pub(crate) struct Scratch<V> {
     body: Vec<Body<V>>,
     meta: Vec<Meta>,
-    count: Vec<u32>,
     cell: Vec<u32>,
     /// The coordinates of each critter's cell (`cell` unpacked, saving divisions).
     coord: Vec<[i64; 3]>,
@@ -419,7 +423,8 @@ fn fly<V: Vector>(
                 }
                 for x in [ev.a, ev.b] {
                     if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
-                        sc.count[x as usize] = sc.count[x as usize].wrapping_add(1);
+                        let m = &mut sc.meta[x as usize];
+                        m.count = m.count.wrapping_add(1);
                         relocate(w, sc, x);
                         refresh(w, sc, x);
                     }
@@ -443,7 +448,8 @@ fn fly<V: Vector>(
                 bounce_border(w, ev.a, ev.b);
                 refresh(w, sc, ev.a);
                 sc.last[ev.a as usize] = BORDER_TAG + ev.b;
-                sc.count[ev.a as usize] = sc.count[ev.a as usize].wrapping_add(1);
+                let m = &mut sc.meta[ev.a as usize];
+                m.count = m.count.wrapping_add(1);
                 predict_all(w, sc, ev.a, t)?;
             }
             CELL => {
@@ -491,11 +497,10 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     let n = w.critters.slot_count();
     sc.heap.reset(n, 0.0, t_end);
     sc.stuck.clear();
-    for v in [&mut sc.count, &mut sc.cell, &mut sc.last] {
+    for v in [&mut sc.cell, &mut sc.last] {
         v.clear();
         v.resize(n, NONE);
     }
-    sc.count.iter_mut().for_each(|c| *c = 0);
     let mut rmax: f64 = 0.0;
     let mut disks = 0usize;
     sc.has_walls = false;
@@ -1067,6 +1072,7 @@ fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) 
 #[inline]
 fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
     let t = sc.body[a as usize].t;
+    let count = sc.meta[a as usize].count;
     let (body, meta) = match w.critters.slot(a) {
         Some(c) => (
             Body {
@@ -1084,6 +1090,7 @@ fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
                 alive: c.alive,
                 wall: c.is_wall(),
                 class: c.class,
+                count,
             },
         ),
         None => (
@@ -1091,7 +1098,10 @@ fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
                 radius: f64::NAN,
                 ..Body::default()
             },
-            Meta::default(),
+            Meta {
+                count,
+                ..Meta::default()
+            },
         ),
     };
     sc.body[a as usize] = body;
@@ -1153,7 +1163,7 @@ fn prefetch_event<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) {
         prefetch(sc.body.get(x));
         prefetch(sc.center.get(x));
         prefetch(slots.get(x));
-        prefetch(sc.count.get(x));
+        prefetch(sc.meta.get(x));
         prefetch(sc.near.data.get(x * sc.near.stride));
         prefetch(sc.near.data.get(x * sc.near.stride + 16));
     }
@@ -1169,11 +1179,11 @@ enum Validity {
 
 fn validity<V: Vector>(sc: &Scratch<V>, ev: &Ev) -> Validity {
     let alive = |x: u32| sc.meta[x as usize].alive;
-    if !alive(ev.a) || sc.count[ev.a as usize] != ev.ca {
+    if !alive(ev.a) || sc.meta[ev.a as usize].count != ev.ca {
         return Validity::Stale;
     }
     let ok = match ev.kind {
-        PAIR => alive(ev.b) && sc.count[ev.b as usize] == ev.cb,
+        PAIR => alive(ev.b) && sc.meta[ev.b as usize].count == ev.cb,
         WALL => alive(ev.b),
         _ => true,
     };
@@ -1192,7 +1202,7 @@ fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: u8) {
         return;
     }
     let cb = if kind == PAIR {
-        sc.count.get(b as usize).copied().unwrap_or(0)
+        sc.meta.get(b as usize).map_or(0, |m| m.count)
     } else {
         0
     };
@@ -1201,7 +1211,7 @@ fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: u8) {
         a,
         b,
         kind,
-        ca: sc.count[a as usize],
+        ca: sc.meta[a as usize].count,
         cb,
     };
     if sc.cand.is_none_or(|c| ev < c) {
@@ -1274,7 +1284,9 @@ fn finish_prediction<V: Vector>(
             predict_pair_or_wall(w, sc, a, b, t, mine)?;
         }
     }
-    sc.best[a as usize] = sc.cand;
+    if !sc.shells {
+        sc.best[a as usize] = sc.cand; // (read by cell crossings only)
+    }
     predict_border(w, sc, a, t, mine);
     if sc.shells {
         predict_shell(sc, a);
