@@ -53,23 +53,39 @@ const CA_ITERATIONS: usize = 64;
 pub const SHELL_FRACTION: f64 = 0.6;
 
 const NONE: u32 = u32::MAX;
-const PAIR: u8 = 0;
-const WALL: u8 = 1;
-const BORDER: u8 = 2;
-const CELL: u8 = 3;
-const RECHECK: u8 = 4;
-const SHELL: u8 = 5;
+/// What an event is. An enum, not a plain byte, so that `Option<Ev>` needs no tag of its own
+/// (it fits the 32 bytes `Ev` takes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(u8)]
+enum Kind {
+    Pair,
+    Wall,
+    Border,
+    Cell,
+    Recheck,
+    Shell,
+}
+const PAIR: Kind = Kind::Pair;
+const WALL: Kind = Kind::Wall;
+const BORDER: Kind = Kind::Border;
+const CELL: Kind = Kind::Cell;
+const RECHECK: Kind = Kind::Recheck;
+const SHELL: Kind = Kind::Shell;
 const BORDER_TAG: u32 = u32::MAX - 16;
 
+/// A predicted event (32 bytes, aligned so that one never straddles two cache lines).
 #[derive(Clone, Copy, Debug)]
+#[repr(align(32))]
 struct Ev {
     time: f64,
     a: u32,
     b: u32,
-    kind: u8,
+    kind: Kind,
     ca: u32,
     cb: u32,
 }
+
+const _: () = assert!(std::mem::size_of::<Option<Ev>>() == 32);
 
 impl Owned for Ev {
     #[inline]
@@ -1197,7 +1213,7 @@ fn validity<V: Vector>(sc: &Scratch<V>, ev: &Ev) -> Validity {
 /// Offers an event to the running prediction: each critter keeps only its earliest event in
 /// the heap (a stale partner makes it predict again when that event comes up).
 #[inline]
-fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: u8) {
+fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: Kind) {
     if sc.cand.is_some_and(|c| time > c.time) {
         return;
     }
@@ -1581,7 +1597,7 @@ fn offer_pair<V: Vector>(
     b: u32,
     t: f64,
     s: f64,
-    kind: u8,
+    kind: Kind,
 ) -> Result<(), Error> {
     let (meta_a, meta_b) = (sc.meta[a as usize], sc.meta[b as usize]);
     let rule = match w.rules.cached(meta_a.class, meta_b.class) {
