@@ -22,14 +22,32 @@ pub(crate) trait Owned: Copy {
     fn owner(&self) -> u32;
 }
 
+/// Where an owner's event is, kept in one place per owner (a queue operation on scattered
+/// owners then touches one cache line each for this, not four).
+#[derive(Clone, Copy, Debug)]
+#[repr(align(16))]
+struct Link {
+    /// `NONE`, `IN_HEAP`, or the bucket whose list holds the event.
+    loc: u32,
+    /// The owner's neighbours in its bucket's list (while listed).
+    next: u32,
+    prev: u32,
+    /// The owner's place in the heap's keys (while in the heap), or `NONE`.
+    at: u32,
+}
+
+const UNLINKED: Link = Link {
+    loc: NONE,
+    next: NONE,
+    prev: NONE,
+    at: NONE,
+};
+
 pub(crate) struct Queue<E> {
     heap: Heap,
-    /// Where each owner's event is: `NONE`, `IN_HEAP`, or the bucket whose list holds it.
-    loc: Vec<u32>,
-    /// The bucket lists: first owner per bucket, then links per owner.
+    links: Vec<Link>,
+    /// The bucket lists: first owner per bucket (then `Link::next`).
     first: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
     /// Each owner's event (meaningful while `loc` is set).
     events: Vec<Option<E>>,
     /// Bucket `b` holds the times from `start + b / per_time` on; the last bucket holds the
@@ -44,10 +62,8 @@ impl<E> Default for Queue<E> {
     fn default() -> Self {
         Self {
             heap: Heap::default(),
-            loc: Vec::new(),
+            links: Vec::new(),
             first: Vec::new(),
-            next: Vec::new(),
-            prev: Vec::new(),
             events: Vec::new(),
             start: 0.0,
             per_time: 0.0,
@@ -75,13 +91,9 @@ impl<E: Owned> Queue<E> {
     /// Empties the queue for owners `0..n` and events between `start` and `end` (later events
     /// are kept too, in the last bucket).
     pub fn reset(&mut self, n: usize, start: f64, end: f64) {
-        self.heap.reset(n);
-        self.loc.clear();
-        self.loc.resize(n, NONE);
-        self.next.clear();
-        self.next.resize(n, NONE);
-        self.prev.clear();
-        self.prev.resize(n, NONE);
+        self.heap.keys.clear();
+        self.links.clear();
+        self.links.resize(n, UNLINKED);
         self.events.clear();
         self.events.resize_with(n, || None);
         let span = end - start;
@@ -103,7 +115,7 @@ impl<E: Owned> Queue<E> {
 
     #[cfg(test)]
     pub fn len(&self) -> usize {
-        self.loc.iter().filter(|&&l| l != NONE).count()
+        self.links.iter().filter(|l| l.loc != NONE).count()
     }
 
     /// The bucket of time `t`: non-decreasing in `t`, so a later bucket means a later time.
@@ -120,20 +132,20 @@ impl<E: Owned> Queue<E> {
         let k = key(e.time(), a);
         self.events[a as usize] = Some(e);
         let b = self.bucket(e.time());
-        let loc = self.loc[a as usize];
+        let loc = self.links[a as usize].loc;
         if b <= self.current {
             if loc == IN_HEAP {
-                self.heap.update(k);
+                self.heap.update(k, &mut self.links);
             } else {
                 if loc != NONE {
                     self.unlink(a, loc as usize);
                 }
-                self.heap.push(k);
-                self.loc[a as usize] = IN_HEAP;
+                self.heap.push(k, &mut self.links);
+                self.links[a as usize].loc = IN_HEAP;
             }
         } else {
             if loc == IN_HEAP {
-                self.heap.remove(a);
+                self.heap.remove(a, &mut self.links);
             } else if loc != NONE {
                 self.unlink(a, loc as usize);
             }
@@ -143,12 +155,12 @@ impl<E: Owned> Queue<E> {
 
     /// Drops owner `a`'s pending event, if it has one.
     pub fn remove(&mut self, a: u32) {
-        match self.loc[a as usize] {
+        match self.links[a as usize].loc {
             NONE => return,
-            IN_HEAP => self.heap.remove(a),
+            IN_HEAP => self.heap.remove(a, &mut self.links),
             b => self.unlink(a, b as usize),
         }
-        self.loc[a as usize] = NONE;
+        self.links[a as usize].loc = NONE;
         self.events[a as usize] = None;
     }
 
@@ -194,94 +206,90 @@ impl<E: Owned> Queue<E> {
         let mut a = self.first[b];
         self.first[b] = NONE;
         while a != NONE {
-            let next = self.next[a as usize];
+            let next = self.links[a as usize].next;
             let e = self.events[a as usize].expect("a listed owner has an event");
-            self.heap.push(key(e.time(), a));
-            self.loc[a as usize] = IN_HEAP;
+            self.heap.push(key(e.time(), a), &mut self.links);
+            self.links[a as usize].loc = IN_HEAP;
             a = next;
         }
     }
 
     fn link(&mut self, a: u32, b: usize) {
         let head = self.first[b];
-        self.next[a as usize] = head;
-        self.prev[a as usize] = NONE;
+        let link = &mut self.links[a as usize];
+        link.next = head;
+        link.prev = NONE;
+        link.loc = b as u32;
         if head != NONE {
-            self.prev[head as usize] = a;
+            self.links[head as usize].prev = a;
         }
         self.first[b] = a;
-        self.loc[a as usize] = b as u32;
     }
 
     fn unlink(&mut self, a: u32, b: usize) {
-        let (p, n) = (self.prev[a as usize], self.next[a as usize]);
+        let Link {
+            prev: p, next: n, ..
+        } = self.links[a as usize];
         if p == NONE {
             self.first[b] = n;
         } else {
-            self.next[p as usize] = n;
+            self.links[p as usize].next = n;
         }
         if n != NONE {
-            self.prev[n as usize] = p;
+            self.links[n as usize].prev = p;
         }
     }
 }
 
-/// An indexed binary min-heap of keys (`key`: time, then owner), at most one per owner.
+/// An indexed binary min-heap of keys (`key`: time, then owner), at most one per owner; each
+/// owner's place in it is kept in its `Link::at`.
 #[derive(Default)]
 struct Heap {
     keys: Vec<u128>,
-    /// Each owner's place in `keys`, or `NONE`.
-    at: Vec<u32>,
 }
 
 impl Heap {
-    fn reset(&mut self, n: usize) {
-        self.keys.clear();
-        self.at.clear();
-        self.at.resize(n, NONE);
-    }
-
     #[inline]
     fn top(&self) -> Option<u128> {
         self.keys.first().copied()
     }
 
-    fn push(&mut self, k: u128) {
+    fn push(&mut self, k: u128, at: &mut [Link]) {
         self.keys.push(k);
-        self.sift_up(self.keys.len() - 1);
+        self.sift_up(self.keys.len() - 1, at);
     }
 
     /// Replaces the key of `k`'s owner (which has one in the heap) by `k`.
-    fn update(&mut self, k: u128) {
-        let i = self.at[owner_of(k) as usize] as usize;
+    fn update(&mut self, k: u128, at: &mut [Link]) {
+        let i = at[owner_of(k) as usize].at as usize;
         let old = self.keys[i];
         self.keys[i] = k;
         if k < old {
-            self.sift_up(i);
+            self.sift_up(i, at);
         } else {
-            self.sift_down(i);
+            self.sift_down(i, at);
         }
     }
 
-    fn remove(&mut self, a: u32) {
-        let i = self.at[a as usize];
+    fn remove(&mut self, a: u32, at: &mut [Link]) {
+        let i = at[a as usize].at;
         if i == NONE {
             return;
         }
-        self.at[a as usize] = NONE;
+        at[a as usize].at = NONE;
         let last = self.keys.pop().expect("an entry is in the heap");
         let i = i as usize;
         if i < self.keys.len() {
             self.keys[i] = last;
             if i > 0 && last < self.keys[(i - 1) / 2] {
-                self.sift_up(i);
+                self.sift_up(i, at);
             } else {
-                self.sift_down(i);
+                self.sift_down(i, at);
             }
         }
     }
 
-    fn sift_up(&mut self, mut i: usize) {
+    fn sift_up(&mut self, mut i: usize, at: &mut [Link]) {
         let entry = self.keys[i];
         while i > 0 {
             let parent = (i - 1) / 2;
@@ -289,14 +297,14 @@ impl Heap {
                 break;
             }
             self.keys[i] = self.keys[parent];
-            self.at[owner_of(self.keys[i]) as usize] = i as u32;
+            at[owner_of(self.keys[i]) as usize].at = i as u32;
             i = parent;
         }
         self.keys[i] = entry;
-        self.at[owner_of(entry) as usize] = i as u32;
+        at[owner_of(entry) as usize].at = i as u32;
     }
 
-    fn sift_down(&mut self, mut i: usize) {
+    fn sift_down(&mut self, mut i: usize, at: &mut [Link]) {
         let entry = self.keys[i];
         let n = self.keys.len();
         loop {
@@ -314,11 +322,11 @@ impl Heap {
                 break;
             }
             self.keys[i] = self.keys[child];
-            self.at[owner_of(self.keys[i]) as usize] = i as u32;
+            at[owner_of(self.keys[i]) as usize].at = i as u32;
             i = child;
         }
         self.keys[i] = entry;
-        self.at[owner_of(entry) as usize] = i as u32;
+        at[owner_of(entry) as usize].at = i as u32;
     }
 }
 
