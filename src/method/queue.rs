@@ -185,10 +185,11 @@ impl<E: Owned> Queue<E> {
     /// may still come first).
     #[inline]
     pub fn runner_up(&self) -> Option<E> {
-        let k = match self.heap.keys.get(1..3)? {
-            [l] => *l,
-            [l, r] => (*l).min(*r),
-            _ => return None,
+        let keys = &self.heap.keys;
+        let k = match keys.len() {
+            0 | 1 => return None,
+            2 => keys[1],
+            _ => keys[1].min(keys[2]),
         };
         self.events[owner_of(k) as usize]
     }
@@ -373,6 +374,31 @@ mod tests {
                     assert_eq!(key(x, p).cmp(&key(y, q)), want, "{x} {p} vs {y} {q}");
                 }
             }
+        }
+    }
+
+    /// With everything in the heap, the runner-up is the second earliest event, whatever the
+    /// number of events (one, two, three or many).
+    #[test]
+    fn the_runner_up_is_the_second_earliest_in_the_heap() {
+        let times = [5.0, 3.0, 4.0, 1.0, 2.0, 0.5, 6.0];
+        for count in 0..=times.len() {
+            let mut q = Queue::<E>::default();
+            q.reset(times.len(), 0.0, 0.0); // no span: one heap
+            for (a, &t) in times.iter().take(count).enumerate() {
+                q.set(E {
+                    t,
+                    a: a as u32,
+                    tag: 0,
+                });
+            }
+            let mut sorted: Vec<f64> = times[..count].to_vec();
+            sorted.sort_by(f64::total_cmp);
+            assert_eq!(
+                q.runner_up().map(|e| e.t),
+                sorted.get(1).copied(),
+                "{count} events"
+            );
         }
     }
 
