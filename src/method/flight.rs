@@ -979,8 +979,8 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     let mut around = [0usize; 27];
     let count = cells_around(w, sc, a, &mut around);
     // The loads are scattered, so each stage asks for what the next one reads before it
-    // reads any: the cells' stripes, then the candidates' centres and bodies, then the new
-    // neighbours' lists.
+    // reads any: the cells' stripes, then the candidates' shell centres (with their radii),
+    // then the new neighbours' lists.
     use crate::world::prefetch;
     for &k in &around[..count] {
         prefetch(sc.cells.data.get(k * sc.cells.stride));
