@@ -1691,8 +1691,9 @@ pub(crate) fn sort_pairs(pairs: &mut [(u32, u32)], slots: usize) -> bool {
 /// of the next pairs to be loaded (they are scattered over memory, and the loads overlap).
 const CANDIDATES_AHEAD: usize = 8;
 
-/// How many slots ahead the move asks for the next critters to be loaded.
-const MOVE_AHEAD: usize = 4;
+/// How many slots ahead the move asks for the next critters to be loaded (8, a kilobyte of
+/// critters ahead: the move at a million critters about 8 % faster than with 4).
+const MOVE_AHEAD: usize = 8;
 
 /// A hint to start loading `slot`'s first cache line (nothing for `None`).
 #[inline]
