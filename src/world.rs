@@ -927,9 +927,6 @@ impl<V: Vector> World<V> {
                 crate::method::swept::step_where_needed(self, &mut stats)?
             }
             Method::Swept => crate::method::swept::step(self, &mut stats)?,
-            Method::Event if per_critter => {
-                crate::method::event::step_where_needed(self, &mut stats)?
-            }
             Method::Event => crate::method::event::step(self, &mut stats)?,
             Method::Solve(n) => {
                 let sweeps = auto_sweeps.unwrap_or(Sweeps::Fixed(n));

@@ -871,6 +871,29 @@ fn a_solve_run_is_replayed_from_its_keyframes_with_its_contact_impulses() {
     replayed_from_keyframes_as_recorded(&all, &r, &[60, 130, 239]);
 }
 
+/// Under `event` a step's flight is kept for the next steps (`method::flight`), with events the
+/// full states do not hold: a replay restores only the full states at steps whose number is a
+/// multiple of `FLIGHT_STEPS`, where the recorded run set its flight up anew, and flies on from
+/// there exactly. With keyframes every 5 steps, steps 37 and 68 come from the states at 30 and
+/// 60, not 35 and 65 (restored there, the replay would set up a flight the recorded run did not,
+/// and the hashes would differ: the replay would fall back to step 0).
+#[test]
+fn an_event_run_is_replayed_from_the_keyframes_where_its_flight_was_set_up() {
+    use critterbox::method::FLIGHT_STEPS;
+    let dir = tmp("restore_event");
+    let (all, sparse) = (dir.join("every1.mcap"), dir.join("every5.mcap"));
+    let args = [
+        "gas", "-n", "200", "--method", "event", "--steps", "90", "--seed", "3",
+    ];
+    record(&all, &[&args[..], &["--record-every", "1"]].concat());
+    record(&sparse, &[&args[..], &["--record-every", "5"]].concat());
+    let r = Recording::open(&sparse).expect("open");
+    assert_eq!(FLIGHT_STEPS, 30, "the steps below assume it");
+    assert_eq!(r.keyframe_at_or_before(37), Some(30));
+    assert_eq!(r.keyframe_at_or_before(68), Some(60));
+    replayed_from_keyframes_as_recorded(&all, &r, &[37, 68, 89]);
+}
+
 /// Each of `steps`, replayed from the keyframe before it in `sparse`, is the state `all` (every
 /// step recorded) holds for it; and the whole of `sparse` verifies.
 fn replayed_from_keyframes_as_recorded(all: &Path, sparse: &Recording, steps: &[u64]) {

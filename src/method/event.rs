@@ -6,8 +6,10 @@
 //! conservative advancement on the exact box distance along a parabola), border hits, and cell
 //! crossings (so each critter only looks at its neighbours) are predicted and processed in time
 //! order by [`crate::method::flight`]; each collision is handed to the caller's `collide` hook.
-//! A step advances exactly dt of event time. See `flight` for the treatment of round-off,
-//! inelastic collapse and resting contacts.
+//! A step advances exactly dt of event time. Without gravity the flight is kept from one step
+//! to the next (its pending events stay queued; only critters changed between the steps predict
+//! again), so a step pays for its events, not for predicting everyone anew. See `flight` for
+//! that, for the treatment of round-off, inelastic collapse and resting contacts.
 
 use crate::error::Error;
 use crate::method::swept::{finish_in_substeps, motion_scale, SWEEP_FRACTION};
@@ -16,29 +18,9 @@ use crate::world::{StepStats, World};
 
 /// One event-driven step of exactly dt (after the update hooks, before the lifecycle).
 pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
-    fly(world, None, stats)
-}
-
-/// The event step as `auto` takes it in a sparse scene: the same events, but a slow critter
-/// (moving less than [`SWEEP_FRACTION`] of the smallest radius or wall thickness) that can meet
-/// nothing along its line this step makes no prediction; it joins in when a collision changes
-/// its flight (as [`crate::method::swept::step_where_needed`] does for the swept step).
-pub fn step_where_needed<V: Vector>(
-    world: &mut World<V>,
-    stats: &mut StepStats,
-) -> Result<(), Error> {
-    let limit = SWEEP_FRACTION * motion_scale(world).smallest();
-    fly(world, Some(limit), stats)
-}
-
-fn fly<V: Vector>(
-    world: &mut World<V>,
-    fast: Option<f64>,
-    stats: &mut StepStats,
-) -> Result<(), Error> {
     let clock = std::time::Instant::now();
     let g = world.gravity;
-    let stopped = crate::method::flight::run(world, g, world.dt, fast, stats)?;
+    let stopped = crate::method::flight::run(world, g, world.dt, None, true, stats)?;
     stats.response += clock.elapsed();
     if let Some(at) = stopped {
         stats.budget_exceeded += 1;

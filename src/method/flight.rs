@@ -27,6 +27,16 @@
 //! contacts under gravity); when it runs out (counted in `StepStats::budget_exceeded`) the
 //! critters are stopped where they are, and `swept` and `event` finish the step in discrete
 //! substeps short enough not to tunnel.
+//!
+//! Kept flights: an event step whose flights are straight lines (no gravity) and in which
+//! everyone predicts keeps its flight for the next step: the pending events stay in the queue
+//! (their predictions look ahead to the end of the flight's life, not just the step's), and the
+//! next step predicts again only the critters that something outside the flight changed between
+//! the steps (a hook, the caller), found by comparing each critter with its body. A step that
+//! cannot go on (a critter came, went or changed size or class, a wall moved, the step's length
+//! or the method changed) sets up a new flight. A flight lives at most [`FLIGHT_STEPS`] steps:
+//! it is set up anew at every step whose number is a multiple of it, so that a run restored
+//! from a recorded state at such a step flies exactly as the recorded run did.
 
 use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
@@ -39,6 +49,10 @@ use crate::rules::PairRule;
 use crate::vector::Vector;
 use crate::world::{at_step, roles_order, StepStats, World};
 use std::cmp::Ordering;
+
+/// A kept flight is set up anew at every step whose number is a multiple of this (see the
+/// module docs); replays restore recorded states at such steps only.
+pub const FLIGHT_STEPS: u64 = 30;
 
 /// Relative shrink of contact distances used for prediction.
 pub const SKIN: f64 = 1e-10;
@@ -244,6 +258,9 @@ pub(crate) struct Scratch<V> {
     /// Cells only, even where shells would pay (tests compare the two).
     #[cfg(test)]
     no_shells: bool,
+    /// A new flight every step, even where it could be kept (tests compare the two).
+    #[cfg(test)]
+    no_keep: bool,
     /// Each critter's shell centre (its position when it was last listed) and its radius (the
     /// body's, kept equal by `refresh`; NaN for walls and the dead), side by side so that
     /// listing reads one place per candidate.
@@ -287,6 +304,23 @@ pub(crate) struct Scratch<V> {
     pair_tests: u64,
     /// Sum over default collisions of contact distance x impulse (the collision virial).
     pub virial: f64,
+    /// The flight kept for the next step, if it may go on.
+    kept: Option<Kept>,
+    /// The flight time the last flight ended at.
+    clock: f64,
+    /// A hook grew a critter beyond the cells in this step (the flight was set up again).
+    grew: bool,
+    /// The critters changed between two steps of a kept flight (kept to save allocations).
+    changed: Vec<u32>,
+}
+
+/// What lets a kept flight go on at the next step.
+#[derive(Clone, Copy, Debug)]
+struct Kept {
+    /// The number of the step that may take it up.
+    step: u64,
+    /// The step's length it was flown with.
+    dt: f64,
 }
 
 /// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
@@ -301,14 +335,73 @@ pub(crate) fn run<V: Vector>(
     acc: V,
     t_end: f64,
     fast: Option<f64>,
+    keep: bool,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
     let mut sc = std::mem::take(&mut world.flight);
     sc.fast = fast;
-    let out = run_with(world, &mut sc, acc, t_end, stats);
-    sc.heap.reset(0, 0.0, 0.0);
+    sc.grew = false;
+    let step = world.step_count;
+    // Kept only for straight flights in which everyone predicts (a curved prediction would have
+    // to look steps ahead; a slow critter that predicts nothing would miss later steps' events).
+    let keep = keep && fast.is_none() && acc.length_squared() == 0.0;
+    #[cfg(test)]
+    let keep = keep && !sc.no_keep;
+    let kept = sc
+        .kept
+        .take()
+        .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
+    let out = match kept {
+        Some(_) => match resume(world, &mut sc, t_end) {
+            Ok(true) => fly_on(world, &mut sc, acc, t_end, stats),
+            Ok(false) => run_with(world, &mut sc, acc, t_end, life(keep, step), stats),
+            Err(e) => Err(e),
+        },
+        None => run_with(world, &mut sc, acc, t_end, life(keep, step), stats),
+    };
+    if keep && !sc.grew && matches!(out, Ok(None)) && !(step + 1).is_multiple_of(FLIGHT_STEPS) {
+        sc.kept = Some(Kept {
+            step: step + 1,
+            dt: t_end,
+        });
+    } else {
+        sc.kept = None;
+        sc.heap.reset(0, 0.0, 0.0);
+    }
     world.flight = sc;
     out
+}
+
+/// The steps a flight set up at step `step` may live (to the next multiple of [`FLIGHT_STEPS`]),
+/// or 1 when it is not kept.
+fn life(keep: bool, step: u64) -> u64 {
+    if keep {
+        FLIGHT_STEPS - step % FLIGHT_STEPS
+    } else {
+        1
+    }
+}
+
+/// A kept flight flown on for one more step of `span`, from where the last one ended.
+fn fly_on<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    span: f64,
+    stats: &mut StepStats,
+) -> Result<Option<f64>, Error> {
+    let start = sc.clock;
+    match fly(w, sc, acc, Some(start), span, 1, stats)? {
+        Flight::Done(stopped) => Ok(stopped),
+        Flight::Grown(t) => {
+            // The rest of the step in new flights, sized for the grown critter.
+            let virial = sc.virial;
+            let rest = run_with(w, sc, acc, span - t, 1, stats);
+            sc.virial += virial;
+            sc.grew = true;
+            Ok(rest?.map(|r| t + r))
+        }
+    }
 }
 
 /// Flies the critters to `t_end`, in one flight unless a hook grows a critter beyond the largest
@@ -319,17 +412,23 @@ fn run_with<V: Vector>(
     sc: &mut Scratch<V>,
     acc: V,
     t_end: f64,
+    life: u64,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
     sc.least_rmax = 0.0;
     let (mut flown, mut virial) = (0.0, 0.0);
     loop {
-        let outcome = fly(w, sc, acc, t_end - flown, stats);
+        // A flight set up again after a critter grew lives to the step's end only.
+        let life = if flown == 0.0 { life } else { 1 };
+        let outcome = fly(w, sc, acc, None, t_end - flown, life, stats);
         virial += sc.virial;
         sc.virial = virial;
         match outcome? {
             Flight::Done(stopped) => return Ok(stopped.map(|t| flown + t)),
-            Flight::Grown(t) => flown += t,
+            Flight::Grown(t) => {
+                sc.grew = true;
+                flown += t
+            }
         }
     }
 }
@@ -342,36 +441,54 @@ enum Flight {
     Grown(f64),
 }
 
+/// Flies for `span` from flight time `from` (a kept flight that `resume` took up), or sets up a
+/// new flight whose predictions look `life` steps of `span` ahead and flies it from 0.
 fn fly<V: Vector>(
     w: &mut World<V>,
     sc: &mut Scratch<V>,
     acc: V,
-    t_end: f64,
+    from: Option<f64>,
+    span: f64,
+    life: u64,
     stats: &mut StepStats,
 ) -> Result<Flight, Error> {
-    setup(w, sc, acc, t_end);
     let n = w.critters.slot_count() as u32;
-    match sc.fast {
-        Some(limit) => {
-            mark_who_may_meet(w, sc);
-            for a in 0..n {
-                if sc.reach[a as usize] > limit || sc.meets[a as usize] {
-                    predict_all(w, sc, a, 0.0)?;
+    let start = match from {
+        Some(t) => t,
+        None => {
+            // A little past the life's last step's end, whatever the rounding of the steps'
+            // sums of dt.
+            let horizon = if life > 1 {
+                span * life as f64 * (1.0 + 1e-9)
+            } else {
+                span
+            };
+            setup(w, sc, acc, span, horizon);
+            match sc.fast {
+                Some(limit) => {
+                    mark_who_may_meet(w, sc);
+                    for a in 0..n {
+                        if sc.reach[a as usize] > limit || sc.meets[a as usize] {
+                            predict_all(w, sc, a, 0.0)?;
+                        }
+                    }
+                }
+                None => {
+                    for a in 0..n {
+                        predict_all(w, sc, a, 0.0)?;
+                    }
                 }
             }
+            0.0
         }
-        None => {
-            for a in 0..n {
-                predict_all(w, sc, a, 0.0)?;
-            }
-        }
-    }
+    };
+    let t_end = if from.is_some() { start + span } else { span };
     let mut processed = 0u64;
     let mut stopped = None;
     let mut grown = None;
     // Every branch below predicts the event's owner again (which replaces the event in the
     // queue) or removes the event.
-    while let Some(ev) = sc.heap.peek() {
+    while let Some(ev) = sc.heap.peek_until(t_end) {
         if ev.time > t_end {
             break;
         }
@@ -489,6 +606,7 @@ fn fly<V: Vector>(
     stats.candidates += sc.predictions as usize;
     // Everyone to the end of the flight.
     let end = grown.or(stopped).unwrap_or(t_end);
+    sc.clock = end;
     let topo = w.topo;
     for a in 0..n {
         advance(w, sc, a, end);
@@ -503,15 +621,78 @@ fn fly<V: Vector>(
         }
     }
     Ok(match grown {
-        Some(t) => Flight::Grown(t),
-        None => Flight::Done(stopped),
+        Some(t) => Flight::Grown(t - start),
+        None => Flight::Done(stopped.map(|t| t - start)),
     })
 }
 
-#[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
-fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
+/// Takes up the flight kept from the last step, for a step of `span` from where it ended:
+/// every critter that something outside the flight changed since (its position or velocity is
+/// not its body's) is counted as changed (its partners' events with it go stale), put in its
+/// cell and predicted again, as after a collision. Returns false, having changed nothing, when
+/// the flight cannot go on: a critter came or went, changed size, class or mobility, or a wall
+/// moved; the step then sets up a new flight.
+fn resume<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, span: f64) -> Result<bool, Error> {
     let n = w.critters.slot_count();
-    sc.heap.reset(n, 0.0, t_end);
+    if n != sc.body.len() {
+        return Ok(false);
+    }
+    let start = sc.clock;
+    let mut changed = std::mem::take(&mut sc.changed);
+    changed.clear();
+    for (a, slot) in w.critters.slot_slice().iter().enumerate() {
+        let (body, meta) = (&sc.body[a], &sc.meta[a]);
+        let Some(c) = slot else {
+            if meta.alive {
+                sc.changed = changed;
+                return Ok(false);
+            }
+            continue;
+        };
+        let same = c.alive == meta.alive
+            && c.is_wall() == meta.wall
+            && (!c.alive
+                || if c.is_wall() {
+                    c.pos == body.pos
+                } else {
+                    c.radius == body.radius && c.class == meta.class && c.fixed != meta.free
+                });
+        if !same {
+            sc.changed = changed;
+            return Ok(false);
+        }
+        if c.alive && !c.is_wall() && (c.pos != body.pos || c.vel != body.vel || body.t != start) {
+            changed.push(a as u32);
+        }
+    }
+    sc.stuck.clear();
+    sc.virial = 0.0;
+    sc.predictions = 0;
+    sc.pair_tests = 0;
+    // The calendar over two steps: the events of this one never wait in its last bucket
+    // (`Queue::peek_until` leaves that, with everything after the next step, unopened).
+    sc.heap.rebase(start, start + 2.0 * span);
+    for &a in &changed {
+        sc.body[a as usize].t = start;
+        let m = &mut sc.meta[a as usize];
+        m.count = m.count.wrapping_add(1);
+        relocate(w, sc, a);
+        refresh(w, sc, a);
+    }
+    let out = changed
+        .iter()
+        .try_for_each(|&a| predict_all(w, sc, a, start));
+    sc.changed = changed;
+    out.map(|()| true)
+}
+
+/// Sets up a new flight for a step of `span`, its predictions looking to `horizon`.
+#[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
+fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, span: f64, horizon: f64) {
+    let n = w.critters.slot_count();
+    // A kept flight's calendar covers two steps (see `resume`).
+    sc.heap
+        .reset(n, 0.0, if horizon > span { 2.0 * span } else { span });
     sc.stuck.clear();
     for v in [&mut sc.cell, &mut sc.last] {
         v.clear();
@@ -545,7 +726,7 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, t_end: f64) {
     sc.last_t.resize(n, f64::NEG_INFINITY);
     sc.straight = acc.length_squared() == 0.0;
     sc.acc = if sc.straight { V::zero() } else { acc };
-    sc.t_end = t_end;
+    sc.t_end = horizon;
     sc.tc = TC_FRACTION * w.dt;
     sc.virial = 0.0;
     sc.predictions = 0;
@@ -1998,6 +2179,91 @@ mod tests {
         assert!(worst < 1e-9, "spheres differ by {worst:e}");
     }
 
+    /// A flight kept from step to step flies what a new flight every step flies: over a few
+    /// collisions per disk (before round-off differences grow chaotically) the same number of
+    /// collisions, every disk in the same place, energy kept, and no two disks overlapping.
+    /// Between the steps some critters are pushed from outside the flight (as a hook or the
+    /// caller may), which the kept flight must notice. Walled 2D gas (cells) and periodic 3D gas
+    /// (shells); dt short, so that most of a step's events were predicted in earlier steps.
+    #[test]
+    fn a_kept_flight_flies_what_a_new_flight_every_step_flies() {
+        fn check<V: crate::Vector>(border: Border, n: usize, speed: f64, dt: f64, steps: usize) {
+            let build = |no_keep: bool| {
+                let mut w = gas::<V>(&GasParams {
+                    n,
+                    packing: 0.3,
+                    dt,
+                    border,
+                    ..GasParams::default()
+                })
+                .expect("the gas builds");
+                // A few collisions per disk in the run.
+                let ids: Vec<_> = w.critters().iter().map(|c| c.id()).collect();
+                for id in ids {
+                    if let Some(c) = w.get_mut(id) {
+                        c.vel = c.vel * speed;
+                    }
+                }
+                w.set_method(Method::Event).expect("event");
+                w.flight.no_keep = no_keep;
+                w
+            };
+            let (mut kept, mut fresh) = (build(false), build(true));
+            let e0 = kept.kinetic_energy();
+            let (mut with_kept, mut with_fresh, mut resumed) = (0, 0, 0);
+            for step in 0..steps {
+                for w in [&mut kept, &mut fresh] {
+                    if step % 7 == 3 {
+                        // A push from outside: every 50th disk turned around.
+                        let ids: Vec<_> = w.critters().iter().map(|c| c.id()).collect();
+                        for id in ids.into_iter().step_by(50) {
+                            if let Some(c) = w.get_mut(id) {
+                                c.vel = -c.vel;
+                            }
+                        }
+                    }
+                }
+                resumed += usize::from(kept.flight.kept.is_some());
+                kept.step().expect("steps");
+                fresh.step().expect("steps");
+                with_kept += kept.stats().impacts;
+                with_fresh += fresh.stats().impacts;
+            }
+            assert!(
+                resumed >= steps / 2,
+                "the flight went on in only {resumed} of {steps} steps"
+            );
+            assert!(fresh.flight.kept.is_none());
+            assert!(
+                with_fresh > 2 * n,
+                "{with_fresh} collisions: too few to compare"
+            );
+            assert_eq!(with_kept, with_fresh);
+            let topo = kept.topo;
+            let cs: Vec<_> = kept.critters().iter().collect();
+            let worst = cs
+                .iter()
+                .zip(fresh.critters().iter())
+                .map(|(a, b)| topo.delta(a.pos, b.pos).length())
+                .fold(0.0, f64::max);
+            // Round-off differences, grown by each collision (a gas is chaotic); a missed or
+            // wrong event would put disks a good part of a radius apart.
+            assert!(worst < 1e-6, "disks differ by {worst:e}");
+            let drift = (kept.kinetic_energy() - e0).abs() / e0;
+            assert!(drift < 1e-12, "energy drift {drift:e}");
+            let mut overlap: f64 = 0.0;
+            for (i, a) in cs.iter().enumerate().filter(|(_, c)| !c.is_wall()) {
+                for b in cs[i + 1..].iter().filter(|c| !c.is_wall()) {
+                    let d = topo.delta(a.pos, b.pos).length();
+                    overlap = overlap.max(a.radius + b.radius - d);
+                }
+            }
+            assert!(overlap < 1e-9, "disks overlap by {overlap:e}");
+        }
+        check::<glam::DVec2>(Border::Bounce, 400, 4.0, 1.0 / 60.0, 120);
+        check::<DVec3>(Border::Wrap, 300, 1.0, 1.0 / 30.0, 30);
+    }
+
     /// The flight's start asks who may meet something pair by pair over the cells
     /// (`mark_who_may_meet`); the answers are `may_meet`'s, critter by critter, for every disk:
     /// walled and periodic gases in 2D and 3D, stirred so that some disks are close and some
@@ -2063,7 +2329,7 @@ mod tests {
             let mut sc = std::mem::take(&mut w.flight);
             sc.fast = Some(limit);
             let dt = w.dt;
-            super::setup(&mut w, &mut sc, V::zero(), dt);
+            super::setup(&mut w, &mut sc, V::zero(), dt, dt);
             super::mark_who_may_meet(&w, &mut sc);
             let (mut yes, mut no) = (0, 0);
             for a in 0..sc.body.len() as u32 {
@@ -2104,7 +2370,7 @@ mod tests {
             .expect("the gas builds");
             let mut sc = std::mem::take(&mut w.flight);
             let dt = w.dt;
-            super::setup(&mut w, &mut sc, V::zero(), dt);
+            super::setup(&mut w, &mut sc, V::zero(), dt, dt);
             let total: usize = sc.dims[..V::DIM].iter().product();
             let cap = 2 * n;
             let widest = (w.topo.size().get(0) / 1.0).floor() as usize;

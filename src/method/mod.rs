@@ -26,6 +26,8 @@ pub mod solve;
 pub mod swept;
 pub mod toi;
 
+pub use flight::FLIGHT_STEPS;
+
 use std::fmt;
 use std::str::FromStr;
 

@@ -56,6 +56,8 @@ pub(crate) struct Queue<E> {
     per_time: f64,
     /// The heap holds the events of the buckets up to this one.
     current: usize,
+    /// The pending events while `rebase` cuts the calendar anew (kept to save allocations).
+    spare: Vec<E>,
 }
 
 impl<E> Default for Queue<E> {
@@ -68,6 +70,7 @@ impl<E> Default for Queue<E> {
             start: 0.0,
             per_time: 0.0,
             current: 0,
+            spare: Vec::new(),
         }
     }
 }
@@ -111,6 +114,21 @@ impl<E: Owned> Queue<E> {
             0.0
         };
         self.current = 0;
+    }
+
+    /// Keeps every pending event, with the calendar cut anew for events between `start` and
+    /// `end` (a flight kept from one step to the next: the next step's span). The pops come in
+    /// the same order of (time, owner) as before.
+    pub fn rebase(&mut self, start: f64, end: f64) {
+        let n = self.links.len();
+        let mut pending = std::mem::take(&mut self.spare);
+        pending.clear();
+        pending.extend(self.events.iter().flatten().copied());
+        self.reset(n, start, end);
+        for &e in &pending {
+            self.set(e);
+        }
+        self.spare = pending;
     }
 
     #[cfg(test)]
@@ -166,13 +184,31 @@ impl<E: Owned> Queue<E> {
 
     /// The earliest event, left in the queue: a caller that predicts its owner again next
     /// replaces it in place.
-    #[inline]
+    #[cfg(test)]
     pub fn peek(&mut self) -> Option<E> {
         loop {
             if let Some(k) = self.heap.top() {
                 return self.events[owner_of(k) as usize];
             }
             if self.current + 1 >= self.first.len() {
+                return None;
+            }
+            self.current += 1;
+            self.open(self.current);
+        }
+    }
+
+    /// The earliest event if it may be at `limit` or before: `None` when every pending event is
+    /// surely later (the buckets after the one `limit` falls in are not opened, nor the last;
+    /// a flight kept for the next step leaves its later events where they are).
+    #[inline]
+    pub fn peek_until(&mut self, limit: f64) -> Option<E> {
+        let last = self.bucket(limit);
+        loop {
+            if let Some(k) = self.heap.top() {
+                return self.events[owner_of(k) as usize];
+            }
+            if self.current + 1 >= self.first.len() || self.current + 1 > last {
                 return None;
             }
             self.current += 1;

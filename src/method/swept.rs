@@ -124,7 +124,7 @@ fn sweep<V: Vector>(
         }
     }
     let fast = fast_only.then_some(limit);
-    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, stats)?;
+    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, false, stats)?;
     stats.response += clock.elapsed();
     match stopped {
         None => world.discrete_collide(stats),

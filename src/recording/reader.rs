@@ -433,9 +433,22 @@ impl Recording {
         self.hashes.keys().next_back().copied().unwrap_or(0)
     }
 
-    /// The nearest step at or before `step` with a full state.
+    /// The nearest step at or before `step` with a full state that a replay can fly on from
+    /// exactly. Under `event` and `auto` that is one whose number is a multiple of
+    /// [`crate::method::FLIGHT_STEPS`] (step 0 is): a kept event flight is set up anew at those
+    /// steps only, and at the others the recorded run flew on with events its full state does
+    /// not hold. Under the other methods a step depends on the full state alone.
     pub fn keyframe_at_or_before(&self, step: u64) -> Option<u64> {
-        self.keyframes.iter().copied().filter(|&k| k <= step).max()
+        use crate::method::{Method, FLIGHT_STEPS};
+        let keeps_flights = !matches!(
+            self.meta().method.parse::<Method>(),
+            Ok(Method::Discrete | Method::Substep(_) | Method::Swept | Method::Solve(_))
+        );
+        self.keyframes
+            .iter()
+            .copied()
+            .filter(|&k| k <= step && (!keeps_flights || k.is_multiple_of(FLIGHT_STEPS)))
+            .max()
     }
 }
 
