@@ -220,9 +220,10 @@ fn every_method_runs_every_shipped_scene_script_and_calls_its_hooks() {
         assert_eq!(field(&out, "method"), m, "{out}");
         assert!(field(&out, "critters").contains("bullet"), "{out}");
     }
+    // The default gas without gravity, too slow to tunnel: the exact event step, its flight kept.
     let o = critterbox(&["run", "gas", "--steps", "5", "--method", "auto"]);
     assert!(
-        field(&stdout(&o), "auto chose").starts_with("discrete"),
+        field(&stdout(&o), "auto chose").starts_with("event"),
         "{}",
         stdout(&o)
     );

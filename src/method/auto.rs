@@ -1,9 +1,15 @@
 //! `auto`: the cheapest method that keeps the scene's tolerances, decided each step and per
 //! critter.
 //!
-//! The discrete step is exact enough while no critter moves more than a fraction of the smallest
+//! The discrete step does not tunnel while no critter moves more than a fraction of the smallest
 //! radius or wall thickness per step (`docs/stability.md` measures where it starts to tunnel).
-//! Beyond that the step's collisions are found in time order, swept or event-driven. Without
+//! Without gravity such a step is still event-driven where the event step keeps its flight from
+//! step to step (`crate::method::flight`): it then costs about what the discrete step does (the
+//! chart's gas at dt 1/960: 2.6 us per step against 2.8-3.0) and is exact. Where something
+//! outside the flight changes more than [`crate::method::flight::CHURN`] of the critters between
+//! steps (hooks steering them, critters coming and going), the kept flight would predict them
+//! all again every step, several discrete steps' cost, so such a step is discrete until the next
+//! step where a flight is set up on schedule, where the event step is tried again. Beyond that the step's collisions are found in time order, swept or event-driven. Without
 //! gravity nothing rests, and the event-driven step flies the swept step's events without its
 //! closing discrete pass, so the step is `event`, dense or sparse, and its flight is kept from
 //! one step to the next while auto keeps taking it (`crate::method::flight`): a step then pays
@@ -104,8 +110,17 @@ pub enum Why {
         /// Critters asleep when the step began.
         asleep: usize,
     },
-    /// Discrete: nobody moves far enough to tunnel.
+    /// Discrete: nobody moves far enough to tunnel, and the event step's flight could not be
+    /// kept from step to step in the last steps (critters changed between them).
     Discrete {
+        /// The largest displacement of a disk in the step.
+        fastest: f64,
+        /// The smallest radius or wall thickness.
+        smallest: f64,
+    },
+    /// Event, though nobody moves far enough to tunnel: without gravity the event step, its
+    /// flight kept from step to step, costs about what the discrete step does, and is exact.
+    Calm {
         /// The largest displacement of a disk in the step.
         fastest: f64,
         /// The smallest radius or wall thickness.
@@ -150,7 +165,12 @@ impl std::fmt::Display for Why {
             }
             Why::Discrete { fastest, smallest } => write!(
                 f,
-                "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e})"
+                "discrete: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}); the event step could not keep its flight from step to step here (more than {churn} of the critters changed between steps, or came or went), so it would cost several discrete steps",
+                churn = crate::method::flight::CHURN
+            ),
+            Why::Calm { fastest, smallest } => write!(
+                f,
+                "event: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete would not tunnel either; without gravity the exact event step, its flight kept from step to step, costs about what the discrete step does"
             ),
             Why::Fast {
                 fastest,
@@ -221,12 +241,24 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
             },
         }
     } else if fastest <= limit {
+        // Without gravity (under it the step was solved above), the event step where its flight
+        // can be kept: tried again from every step where a flight is set up on schedule, so the
+        // choice does not depend on anything before such a step (a replay restores there).
+        let calm = !falling && !world.flight.churned(world.step_count);
         Choice {
-            method: Method::Discrete,
+            method: if calm {
+                Method::Event
+            } else {
+                Method::Discrete
+            },
             per_critter: false,
             substeps: 1,
             sweeps: AUTO,
-            why: Why::Discrete { fastest, smallest },
+            why: if calm {
+                Why::Calm { fastest, smallest }
+            } else {
+                Why::Discrete { fastest, smallest }
+            },
         }
     } else {
         let (fast, all) = count_fast(world, limit);
@@ -276,6 +308,15 @@ mod tests {
         .to_string();
         assert!(discrete.starts_with("discrete: "), "{discrete}");
         assert!(discrete.contains("1.780e-3") && discrete.contains("(2.000e-1)"));
+        assert!(discrete.contains("could not keep its flight"), "{discrete}");
+        let calm = Why::Calm {
+            fastest: 1.78e-3,
+            smallest: 0.2,
+        }
+        .to_string();
+        assert!(calm.starts_with("event: "), "{calm}");
+        assert!(calm.contains("1.780e-3") && calm.contains("(2.000e-1)"));
+        assert!(calm.contains("kept from step to step"), "{calm}");
         let fast = |packing, event| {
             Why::Fast {
                 fastest: 0.5,

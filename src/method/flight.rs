@@ -312,6 +312,25 @@ pub(crate) struct Scratch<V> {
     grew: bool,
     /// The critters changed between two steps of a kept flight (kept to save allocations).
     changed: Vec<u32>,
+    /// The step at which the last event step that could have kept its flight could not, or had
+    /// to predict more than [`CHURN`] of its critters again: something outside the flight
+    /// changes critters every step (hooks steering them, spawns), and the kept flight does not
+    /// pay (`auto` reads it). `None` when the last such step kept its flight.
+    churned_at: Option<u64>,
+}
+
+/// The fraction of the critters a kept flight may have to predict again at a step's start and
+/// still count as kept ([`Scratch::churned`]).
+pub const CHURN: f64 = 0.125;
+
+impl<V> Scratch<V> {
+    /// Whether an event step since the last step set up on schedule (the last multiple of
+    /// [`FLIGHT_STEPS`] at or before `step`) found its flight churned (see the field). Nothing
+    /// before that step counts, so that a run restored there chooses the same.
+    pub(crate) fn churned(&self, step: u64) -> bool {
+        self.churned_at
+            .is_some_and(|at| at >= step - step % FLIGHT_STEPS)
+    }
 }
 
 /// What lets a kept flight go on at the next step.
@@ -351,10 +370,22 @@ pub(crate) fn run<V: Vector>(
         .kept
         .take()
         .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
+    let disks = world
+        .critters
+        .iter()
+        .filter(|c| c.alive && !c.is_wall())
+        .count();
     let out = match kept {
         Some(_) => match resume(world, &mut sc, t_end) {
-            Ok(true) => fly_on(world, &mut sc, acc, t_end, stats),
-            Ok(false) => run_with(world, &mut sc, acc, t_end, life(keep, step), stats),
+            Ok(true) => {
+                let churned = sc.changed.len() as f64 > CHURN * disks as f64;
+                sc.churned_at = churned.then_some(step);
+                fly_on(world, &mut sc, acc, t_end, stats)
+            }
+            Ok(false) => {
+                sc.churned_at = Some(step);
+                run_with(world, &mut sc, acc, t_end, life(keep, step), stats)
+            }
             Err(e) => Err(e),
         },
         None => run_with(world, &mut sc, acc, t_end, life(keep, step), stats),
