@@ -622,6 +622,25 @@ fn commands_inspect_diff_export_and_their_exit_codes() {
     assert_eq!(o.status.code(), Some(2), "conflicting flags: {}", text(&o));
 }
 
+/// Every recording shipped in `recordings/` verifies from the file alone, as the README's
+/// readers will try: the goldens `critterbox test --bless` writes record the script limits the
+/// run had (they once recorded zeros, and a replay then refused the scene's first spawn).
+#[test]
+fn the_shipped_recordings_verify_from_their_files_alone() {
+    let dir = Path::new(ROOT).join("recordings");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).expect("recordings/") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "mcap") {
+            let o = critterbox(&["replay", path.to_str().unwrap(), "--verify"]);
+            assert!(o.status.success(), "{}: {}", path.display(), text(&o));
+            assert!(text(&o).contains("verify       ok"), "{}", text(&o));
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "only {checked} recordings in recordings/");
+}
+
 #[test]
 fn run_records_by_default_under_the_recordings_folder() {
     let dir = tmp("default_path");

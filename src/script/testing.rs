@@ -388,9 +388,19 @@ fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
     let file = PathBuf::from(path);
     if host.bless.get() {
         let steps = with_scene(host, |s| s.default_steps)?;
+        // The limits the scene runs under, recorded so that a replay rebuilds it under them
+        // (`RunArgs::default()` holds zeros, not the command line's defaults).
+        let limits = host
+            .runtime
+            .borrow()
+            .upgrade()
+            .map_or_else(|| fail("the script runtime is gone"), Ok)?
+            .limits
+            .clone();
         let rec = with_scene(host, |scene| {
             let mut meta =
                 crate::cli::record::run_meta(&crate::cli::run::RunArgs::default(), scene, steps);
+            meta.limits = limits.clone();
             // Only the hashes are compared: full states at the start and the end keep it small.
             meta.record_every = steps.max(1);
             crate::recording::Recorder::create(&file, &meta, &scene.sources, &scene.world)
