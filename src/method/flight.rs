@@ -370,18 +370,9 @@ pub(crate) fn run<V: Vector>(
         .kept
         .take()
         .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
-    let disks = world
-        .critters
-        .iter()
-        .filter(|c| c.alive && !c.is_wall())
-        .count();
     let out = match kept {
-        Some(_) => match resume(world, &mut sc, t_end) {
-            Ok(true) => {
-                let churned = sc.changed.len() as f64 > CHURN * disks as f64;
-                sc.churned_at = churned.then_some(step);
-                fly_on(world, &mut sc, acc, t_end, stats)
-            }
+        Some(_) => match resume(world, &mut sc, t_end, step) {
+            Ok(true) => fly_on(world, &mut sc, acc, t_end, stats),
             Ok(false) => {
                 sc.churned_at = Some(step);
                 run_with(world, &mut sc, acc, t_end, life(keep, step), stats)
@@ -660,10 +651,16 @@ fn fly<V: Vector>(
 /// Takes up the flight kept from the last step, for a step of `span` from where it ended:
 /// every critter that something outside the flight changed since (its position or velocity is
 /// not its body's) is counted as changed (its partners' events with it go stale), put in its
-/// cell and predicted again, as after a collision. Returns false, having changed nothing, when
-/// the flight cannot go on: a critter came or went, changed size, class or mobility, or a wall
-/// moved; the step then sets up a new flight.
-fn resume<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, span: f64) -> Result<bool, Error> {
+/// cell and predicted again, as after a collision (and the flight counted churned at `step`
+/// when they are more than [`CHURN`] of the disks). Returns false, having changed nothing, when
+/// the flight cannot go on (the caller counts that as churned): a critter came or went, changed
+/// size, class or mobility, or a wall moved; the step then sets up a new flight.
+fn resume<V: Vector>(
+    w: &mut World<V>,
+    sc: &mut Scratch<V>,
+    span: f64,
+    step: u64,
+) -> Result<bool, Error> {
     let n = w.critters.slot_count();
     if n != sc.body.len() {
         return Ok(false);
@@ -671,6 +668,7 @@ fn resume<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, span: f64) -> Result
     let start = sc.clock;
     let mut changed = std::mem::take(&mut sc.changed);
     changed.clear();
+    let mut disks = 0usize;
     for (a, slot) in w.critters.slot_slice().iter().enumerate() {
         let (body, meta) = (&sc.body[a], &sc.meta[a]);
         let Some(c) = slot else {
@@ -692,10 +690,15 @@ fn resume<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, span: f64) -> Result
             sc.changed = changed;
             return Ok(false);
         }
-        if c.alive && !c.is_wall() && (c.pos != body.pos || c.vel != body.vel || body.t != start) {
-            changed.push(a as u32);
+        if c.alive && !c.is_wall() {
+            disks += 1;
+            if c.pos != body.pos || c.vel != body.vel || body.t != start {
+                changed.push(a as u32);
+            }
         }
     }
+    let churned = changed.len() as f64 > CHURN * disks as f64;
+    sc.churned_at = churned.then_some(step);
     sc.stuck.clear();
     sc.virial = 0.0;
     sc.predictions = 0;
