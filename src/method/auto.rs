@@ -9,16 +9,18 @@
 //! outside the flight changes more than [`crate::method::flight::CHURN`] of the critters between
 //! steps (hooks steering them, critters coming and going), the kept flight would predict them
 //! all again every step, several discrete steps' cost, so such a step is discrete until the next
-//! step where a flight is set up on schedule, where the event step is tried again. Beyond that the step's collisions are found in time order, swept or event-driven. Without
-//! gravity nothing rests, and the event-driven step flies the swept step's events without its
-//! closing discrete pass, so the step is `event`, dense or sparse, and its flight is kept from
-//! one step to the next while auto keeps taking it (`crate::method::flight`): a step then pays
-//! for its events, not for predicting everyone anew (the chart's gas: the same error at event's
-//! cost, where swept costs 1.2 to 1.3 times more; a bullet among 360 slow disks, 120 steps:
-//! 12.8 us per step, where the event step taken per critter, as auto took it before, cost 36).
-//! Under gravity a step too fast for solved substeps stays swept, since resting contacts are
-//! the event step's worst case; in a sparse scene (disks cover less than [`SPARSE`] of the box) that swept step is
-//! taken per critter ([`crate::method::swept::step_where_needed`]): a slow critter that can
+//! step where a flight is set up on schedule, where the event step is tried again.
+//!
+//! Beyond that fraction the step's collisions are found in time order, swept or event-driven.
+//! Without gravity nothing rests, and the event-driven step flies the swept step's events
+//! without its closing discrete pass, so the step is `event`, dense or sparse, its flight kept
+//! from one step to the next while auto keeps taking it: a step then pays for its events, not
+//! for predicting everyone anew (the chart's gas: the same error at event's cost, where swept
+//! costs 1.2 to 1.3 times more; a bullet among 360 slow disks, 120 steps: 12.8 us per step,
+//! where the event step taken per critter, as auto took it before, cost 36). Under gravity a
+//! step too fast for solved substeps stays swept, since resting contacts are the event step's
+//! worst case; in a sparse scene (disks cover less than [`SPARSE`] of the box) that swept step
+//! is taken per critter ([`crate::method::swept::step_where_needed`]): a slow critter that can
 //! meet nothing along its line this step makes no prediction until a collision changes its
 //! flight. The events are the same, so the accuracy is too; a few bullets among many
 //! spread-out slow critters cost the bullets' predictions, not everyone's. In a dense scene
