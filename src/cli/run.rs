@@ -10,7 +10,7 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 /// Arguments of `critterbox run`.
-#[derive(Args, Debug, Default)]
+#[derive(Args, Debug)]
 pub struct RunArgs {
     /// A scene script (scripts/scenes/NAME.rhai) or a built-in scene (see --list). Default: gas.
     pub scene: Option<String>,
@@ -258,6 +258,21 @@ fn parse_method(s: &str) -> Result<crate::method::Method, String> {
 }
 
 /// The script limits the command line asks for.
+impl Default for RunArgs {
+    /// What `critterbox run` with no arguments gets (also `critterbox` alone, and the runs
+    /// `critterbox test` records): the command line's defaults. A derived `Default` gave zeros
+    /// for the script limits, which recordings then carried, and a replay of them refused the
+    /// scene's first spawn.
+    fn default() -> Self {
+        #[derive(clap::Parser)]
+        struct Bare {
+            #[command(flatten)]
+            args: RunArgs,
+        }
+        <Bare as clap::Parser>::parse_from(["critterbox"]).args
+    }
+}
+
 pub(crate) fn limits(args: &RunArgs) -> Limits {
     Limits {
         max_operations: args.max_ops,
@@ -427,4 +442,18 @@ fn peak_rss_bytes() -> Option<u64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `RunArgs::default()` is what the command line gives with no arguments: the script limits'
+    /// defaults, not zeros (a recording made from it carries them into its replays).
+    #[test]
+    fn default_run_args_are_the_command_line_s_defaults() {
+        let args = RunArgs::default();
+        assert_eq!(limits(&args), Limits::default());
+        assert!(args.scene.is_none() && args.sets.is_empty() && args.steps.is_none());
+    }
 }

@@ -388,8 +388,8 @@ fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
     let file = PathBuf::from(path);
     if host.bless.get() {
         let steps = with_scene(host, |s| s.default_steps)?;
-        // The limits the scene runs under, recorded so that a replay rebuilds it under them
-        // (`RunArgs::default()` holds zeros, not the command line's defaults).
+        // The limits the scene runs under (the test runner's, not `run`'s defaults), recorded
+        // so that a replay rebuilds it under them.
         let limits = host
             .runtime
             .borrow()
