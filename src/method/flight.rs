@@ -504,7 +504,7 @@ fn fly<V: Vector>(
             0.0
         }
     };
-    let t_end = if from.is_some() { start + span } else { span };
+    let t_end = start + span; // (exactly `span` for a new flight, which starts at 0)
     let mut processed = 0u64;
     let mut stopped = None;
     let mut grown = None;
