@@ -151,14 +151,17 @@ struct Level<V: Vector> {
     inv_cell: [f64; 3],
     dims: [usize; 3],
     wrap: [bool; 3],
-    /// Cell key of each member, in the order of their indices.
-    keys: Vec<u32>,
-    /// `start[k]..start[k + 1]` indexes `sorted` for cell `k`.
+    /// `start[k]..start[k + 1]` indexes `sorted` (or `members`) for cell `k`.
     start: Vec<u32>,
-    /// The members' boxes in cell order, so the pair loops read memory in order.
+    /// The members' boxes in cell order, so the pair loops read memory in order (empty once
+    /// [`Level::slim`]).
     sorted: Vec<CellBox<V>>,
     /// Cell key of each entry of `sorted`.
     sorted_keys: Vec<u32>,
+    /// Once a Verlet list's build is done with them ([`Level::slim`]): the tag of each entry
+    /// of `sorted` (its index, with [`WALL`] for a wall), in the same order, while `sorted` and
+    /// `sorted_keys` are let go.
+    members: Vec<u32>,
 }
 
 impl<V: Vector> Default for Level<V> {
@@ -167,10 +170,10 @@ impl<V: Vector> Default for Level<V> {
             inv_cell: [0.0; 3],
             dims: [1; 3],
             wrap: [false; 3],
-            keys: Vec::new(),
             start: Vec::new(),
             sorted: Vec::new(),
             sorted_keys: Vec::new(),
+            members: Vec::new(),
         }
     }
 }
@@ -301,6 +304,21 @@ impl<V: Vector> Level<V> {
     /// overlap `b`'s.
     #[inline]
     fn for_each_near(&self, topo: &Topology<V>, b: &CellBox<V>, mut f: impl FnMut(&CellBox<V>)) {
+        self.for_each_cell_near(topo, b, |k| self.cell(k).iter().for_each(&mut f));
+    }
+
+    /// [`Self::for_each_near`] for a slim level ([`Self::slim`]): `f` gets each member's tag.
+    #[inline]
+    fn for_each_member_near(&self, topo: &Topology<V>, b: &CellBox<V>, mut f: impl FnMut(u32)) {
+        self.for_each_cell_near(topo, b, |k| {
+            let cell = &self.members[self.start[k] as usize..self.start[k + 1] as usize];
+            cell.iter().copied().for_each(&mut f);
+        });
+    }
+
+    /// Calls `f` with the key of each cell of `b`'s footprint.
+    #[inline]
+    fn for_each_cell_near(&self, topo: &Topology<V>, b: &CellBox<V>, mut f: impl FnMut(usize)) {
         let ranges = self.footprint(topo, b);
         for k in 0..ranges[2].1 {
             for j in 0..ranges[1].1 {
@@ -310,10 +328,23 @@ impl<V: Vector> Level<V> {
                         self.axis_cell(1, ranges[1].0 + j as i64),
                         self.axis_cell(2, ranges[2].0 + k as i64),
                     ];
-                    self.cell(self.key(c)).iter().for_each(&mut f);
+                    f(self.key(c));
                 }
             }
         }
+    }
+
+    /// Keeps of the members only their tags in cell order (`members`, written over the cell
+    /// keys) and gives up their boxes: what a Verlet list's repairs need of a build's level,
+    /// since the list's bounds hold the boxes. Returns the boxes' buffer, for the bounds to be
+    /// written into (and handed back at the next build), so that the bounds and the boxes are
+    /// never kept at once: at a million disks in 2D, 20 bytes per disk.
+    fn slim(&mut self) -> Vec<CellBox<V>> {
+        for (key, b) in self.sorted_keys.iter_mut().zip(&self.sorted) {
+            *key = b.tag;
+        }
+        self.members = std::mem::take(&mut self.sorted_keys);
+        std::mem::take(&mut self.sorted)
     }
 
     /// Cell index `i` along `axis`, wrapped on periodic axes (in range otherwise).
@@ -482,11 +513,11 @@ impl<V: Vector> Level<V> {
         let ncells = self.dims[0] * self.dims[1] * self.dims[2];
         self.start.clear();
         self.start.resize(ncells + 1, 0);
-        self.keys.clear();
+        let mut m = 0;
         for (_, o) in members() {
             let k = self.key(self.coords(topo, o.center));
-            self.keys.push(k as u32);
             self.start[k] += 1;
+            m += 1;
         }
         // Exclusive prefix sum, carried in a register (a loop through memory stalls on each add).
         let mut acc = 0u32;
@@ -495,15 +526,20 @@ impl<V: Vector> Level<V> {
             *s = acc;
             acc += count;
         }
-        let m = self.keys.len();
         self.sorted.clear();
         self.sorted.resize(m, CellBox::default());
+        if self.sorted_keys.capacity() == 0 {
+            // A slim level's tags are not read again once it is built anew.
+            self.sorted_keys = std::mem::take(&mut self.members);
+        }
         self.sorted_keys.clear();
         self.sorted_keys.resize(m, 0);
         // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
         // the shift below turns ends back into starts.
-        for (j, (i, o)) in members().enumerate() {
-            let k = self.keys[j] as usize;
+        // Each key is found again from the centre (a few operations on what is read anyway)
+        // rather than kept from the count: 4 bytes per member less.
+        for (i, o) in members() {
+            let k = self.key(self.coords(topo, o.center));
             let at = self.start[k] as usize;
             self.sorted[at] = CellBox::new(&o, i, pad);
             self.sorted_keys[at] = k as u32;
@@ -528,6 +564,9 @@ const REPAIR_WORK: f64 = 4.0;
 
 /// Objects per run of cells walked by one task when a level's pairs are found in parallel.
 const RUN_OBJECTS: usize = 8192;
+
+/// Runs of [`RUN_OBJECTS`] walked in parallel before their pairs are joined onto the list.
+const RUNS_AT_ONCE: usize = 16;
 
 /// The skin of the Verlet list, as a fraction of the objects' typical width: 0.6 in 2D, 0.4 in
 /// 3D. A larger skin means fewer rebuilds and more kept pairs to re-test; in 2D 0.6 against 0.4
@@ -594,31 +633,28 @@ fn typical_stride<V: Vector, O: Objects<V> + ?Sized>(objs: &O) -> f64 {
 
 /// Where one index's object may be while the Verlet list stays valid: its box at the build widened
 /// by half the skin, in single precision rounded inwards, so that a box inside the bound is inside
-/// the widened box its pairs were found with. Half the size of a [`BroadObject`] (20 bytes in 2D,
-/// 28 in 3D): at a million critters the bounds are 20 MB less to keep and to read every step.
-#[derive(Clone, Copy, Debug)]
-struct Bound<V: Vector> {
-    /// The centre at the build, to the nearest `f32` (NaN for a gap).
-    center: V::Single,
-    /// Per axis, how far the box may reach from `center`: the widened half size less the
-    /// centre's rounding, rounded down.
-    room: V::Single,
-    /// The object's slot, with [`WALL`] set for a wall; [`GAP`] for a gap.
-    tag: u32,
-}
+/// the widened box its pairs were found with. A [`CellBox`] made by [`CellBox::bound`] (its half
+/// sizes are then how far the object's box may reach from the centre), so that the bounds and a
+/// level's cell-sorted boxes can take turns with one buffer (see [`Level::slim`]); 20 bytes in
+/// 2D, 28 in 3D.
+type Bound<V> = CellBox<V>;
 
 /// The tag of a gap's [`Bound`] (its centre is NaN too, so no object is ever inside it).
 const GAP: u32 = u32::MAX;
 
-impl<V: Vector> Bound<V> {
+impl<V: Vector> CellBox<V> {
+    /// The [`Bound`] of `o` widened by `pad`: the centre to the nearest `f32`, the half sizes
+    /// (how far the box may reach from the centre) the widened ones less the centre's rounding,
+    /// rounded down; the slot as the tag, with [`WALL`] for a wall. A gap's is NaN, tagged
+    /// [`GAP`].
     #[inline]
-    fn new(o: Option<&BroadObject<V>>, pad: f64) -> Self {
+    fn bound(o: Option<&BroadObject<V>>, pad: f64) -> Self {
         let Some(o) = o else {
             let mut nan = V::Single::default();
             nan.as_mut().fill(f32::NAN);
-            return Bound {
+            return CellBox {
                 center: nan,
-                room: nan,
+                half: nan,
                 tag: GAP,
             };
         };
@@ -627,15 +663,16 @@ impl<V: Vector> Bound<V> {
         for (axis, r) in room.as_mut().iter_mut().enumerate() {
             *r = at_most(o.half.get(axis) + pad - moved.get(axis));
         }
-        Bound {
+        CellBox {
             center,
-            room,
+            half: room,
             tag: tag_of(o),
         }
     }
 
-    /// True when `o` is what the bound was made from, a gap for a gap, or for an object the box
-    /// of one with the same slot and wall flag that lies inside the bound. Never for a NaN.
+    /// For a [`Bound`]: true when `o` is what the bound was made from, a gap for a gap, or for
+    /// an object the box of one with the same slot and wall flag that lies inside the bound.
+    /// Never for a NaN.
     #[inline]
     fn holds(&self, topo: &Topology<V>, o: Option<&BroadObject<V>>) -> bool {
         let Some(o) = o else {
@@ -645,7 +682,7 @@ impl<V: Vector> Bound<V> {
             return false;
         }
         let d = topo.delta(V::from_single(self.center), o.center);
-        let room = self.room.as_ref();
+        let room = self.half.as_ref();
         (0..V::DIM).all(|axis| d.get(axis).abs() + o.half.get(axis) <= f64::from(room[axis]))
     }
 }
@@ -766,6 +803,9 @@ pub struct BroadPhase<V: Vector> {
     level_of: Vec<u8>,
     /// The grid's pairs before their exact test, kept between calls (`BroadPhaseMode::Grid`).
     found: Vec<(u32, u32)>,
+    /// During a Verlet list's build, the old bounds' buffer, for the first level built without
+    /// one of its own to hold its boxes in.
+    spare: Vec<CellBox<V>>,
     /// Number of bounding-box tests made in the last call.
     pub tests: u64,
     /// Number of grid levels used in the last call (0 for the direct loop).
@@ -781,6 +821,7 @@ impl<V: Vector> Default for BroadPhase<V> {
             used: Vec::new(),
             level_of: Vec::new(),
             found: Vec::new(),
+            spare: Vec::new(),
             tests: 0,
             levels_used: 0,
         }
@@ -1087,12 +1128,24 @@ impl<V: Vector> BroadPhase<V> {
         };
         let mut pairs = std::mem::take(&mut self.list.pairs);
         pairs.clear();
+        // The old bounds' buffer takes the grid's boxes, and the boxes' buffer, once the pairs
+        // are found, the new bounds: the two are never kept at once.
+        self.spare = std::mem::take(&mut self.list.bounds);
         self.grid_padded(&led, topo, &mut pairs, 0.5 * skin);
+        let mut buffer = std::mem::take(&mut self.spare);
+        for level in &mut self.levels {
+            let boxes = level.slim();
+            if boxes.capacity() > buffer.capacity() {
+                buffer = boxes;
+            }
+        }
         self.list.pairs = pairs;
         self.list.sorted = false;
         self.list.sort_wanted = false;
-        let bound = |i: usize| Bound::new(led.object(i).as_ref(), 0.5 * skin);
-        self.list.bounds.clear();
+        let bound = |i: usize| Bound::bound(led.object(i).as_ref(), 0.5 * skin);
+        buffer.clear();
+        buffer.reserve_exact(objs.slots());
+        self.list.bounds = buffer;
         if objs.slots() >= crate::world::PARALLEL_MIN {
             use rayon::prelude::*;
             self.list
@@ -1172,14 +1225,19 @@ impl<V: Vector> BroadPhase<V> {
             .retain(|&(a, b)| !bit(&leaving, a as usize) && !bit(&leaving, b as usize));
         let kept = list.pairs.len();
         for (i, b) in fresh {
-            list.bounds[i as usize] = Bound::new(led.object(i as usize).as_ref(), half_skin);
+            list.bounds[i as usize] = Bound::bound(led.object(i as usize).as_ref(), half_skin);
             let Some(b) = b else {
                 continue;
             };
+            // The others' bounds stand for their boxes at the build: each holds its object's
+            // box for as long as the object is not mended, and lies inside that box.
             for &l in &self.used {
-                self.levels[l].for_each_near(topo, &b, |a| {
-                    if !bit(&list.moved, a.index() as usize) && cells_overlap(topo, a, &b) {
-                        list.pairs.push((a.index(), i));
+                self.levels[l].for_each_member_near(topo, &b, |tag| {
+                    let a = tag & !WALL;
+                    if !bit(&list.moved, a as usize)
+                        && cells_overlap(topo, &list.bounds[a as usize], &b)
+                    {
+                        list.pairs.push((a, i));
                     }
                 });
             }
@@ -1375,6 +1433,9 @@ impl<V: Vector> BroadPhase<V> {
                         Some((i as u32, objs.object(i)?))
                     })
             };
+            if self.levels[l].sorted.capacity() == 0 {
+                std::mem::swap(&mut self.levels[l].sorted, &mut self.spare);
+            }
             floor_cell = self.levels[l].build(members, topo, cell, limit, pad);
         }
         self.levels_used = used.len();
@@ -1394,17 +1455,21 @@ impl<V: Vector> BroadPhase<V> {
             if m >= crate::world::PARALLEL_MIN && rayon::current_num_threads() > 1 {
                 use rayon::prelude::*;
                 let runs = level.cell_runs(RUN_OBJECTS);
-                let parts: Vec<(Vec<(u32, u32)>, u64)> = runs
-                    .into_par_iter()
-                    .map(|run| {
-                        let mut part = Vec::new();
-                        let tests = walk(run, &mut part);
-                        (part, tests)
-                    })
-                    .collect();
-                for (part, tests) in parts {
-                    out.extend(part);
-                    self.tests += tests;
+                // A few runs at a time, so that the parts waiting to be joined are a slice of
+                // the list, not a second copy of it (at a million disks, 8 bytes per disk).
+                for batch in runs.chunks(RUNS_AT_ONCE) {
+                    let parts: Vec<(Vec<(u32, u32)>, u64)> = batch
+                        .par_iter()
+                        .map(|run| {
+                            let mut part = Vec::new();
+                            let tests = walk(run.clone(), &mut part);
+                            (part, tests)
+                        })
+                        .collect();
+                    for (part, tests) in parts {
+                        out.extend(part);
+                        self.tests += tests;
+                    }
                 }
             } else {
                 self.tests += walk(0..m, out);
@@ -1615,7 +1680,7 @@ mod tests {
                 slot: 3,
                 is_wall: false,
             };
-            let bound = Bound::new(Some(&at(center, half)), pad);
+            let bound = Bound::bound(Some(&at(center, half)), pad);
             assert!(
                 bound.holds(&topo, Some(&at(center, half))),
                 "the box it was made from"
@@ -1646,7 +1711,7 @@ mod tests {
             };
             assert!(!bound.holds(&topo, Some(&wall)), "a wall in a disk's place");
             assert!(!bound.holds(&topo, None), "a gap in an object's place");
-            let gap = Bound::new(None, pad);
+            let gap = Bound::bound(None, pad);
             assert!(gap.holds(&topo, None), "a gap in a gap's place");
             assert!(
                 !gap.holds(&topo, Some(&at(center, half))),
@@ -2141,11 +2206,12 @@ mod tests {
         let mut rng = Rng::new(5);
         let topo = Topology {
             min: DVec2::ZERO,
-            max: DVec2::splat(150.0),
+            max: DVec2::splat(330.0),
             border: Border::Bounce,
         };
-        // Equal radii: one level, of more objects than the parallel threshold.
-        let objs = random_objs::<DVec2>(&mut rng, 30_000, 150.0, 0.4, 0.4);
+        // Equal radii: one level, of more objects than the parallel threshold, in more runs
+        // than are walked at once.
+        let objs = random_objs::<DVec2>(&mut rng, 140_000, 330.0, 0.4, 0.4);
         let found = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -2159,7 +2225,10 @@ mod tests {
         let (bp, out) = found(2);
         assert_eq!(bp.levels_used, 1);
         let level = &bp.levels[0];
-        assert!(level.cell_runs(RUN_OBJECTS).len() >= 3, "a few runs");
+        assert!(
+            level.cell_runs(RUN_OBJECTS).len() > RUNS_AT_ONCE,
+            "more runs than are walked at once"
+        );
         let forward = level.offsets(true);
         let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
         let mut whole = Vec::new();
@@ -2173,6 +2242,53 @@ mod tests {
             .collect();
         assert_eq!(out, exact_pairs);
         assert_eq!(found(1).1, out);
+    }
+
+    #[test]
+    fn a_built_list_keeps_its_bounds_and_not_the_grid_s_boxes() {
+        let mut rng = Rng::new(9);
+        let topo = Topology {
+            min: DVec2::ZERO,
+            max: DVec2::splat(100.0),
+            border: Border::Wrap,
+        };
+        // Two sizes of disk: two levels.
+        let mut objs = random_objs::<DVec2>(&mut rng, 4_000, 100.0, 0.3, 0.3);
+        objs.extend(random_objs::<DVec2>(&mut rng, 100, 100.0, 3.0, 3.0));
+        for (i, o) in objs.iter_mut().enumerate() {
+            o.slot = i as u32;
+        }
+        let mut bp = BroadPhase::new(BroadPhaseMode::Auto);
+        let mut out = Vec::new();
+        let mut buffers = Vec::new();
+        for build in 1..=3u64 {
+            bp.find_pairs(&objs, &topo, &mut out);
+            assert_eq!(
+                normalise(out.clone()),
+                normalise(brute(&objs, &topo)),
+                "build {build}"
+            );
+            assert_eq!(bp.rebuilds(), build);
+            assert_eq!(bp.used.len(), 2);
+            // Each level keeps its members' tags, and neither their boxes nor their keys.
+            let mut members = 0;
+            for &l in &bp.used {
+                let level = &bp.levels[l];
+                assert_eq!(level.sorted.capacity(), 0, "level {l}'s boxes");
+                assert_eq!(level.sorted_keys.capacity(), 0, "level {l}'s keys");
+                members += level.members.len();
+            }
+            assert_eq!(members, objs.len());
+            assert!(bp.spare.capacity() == 0, "no spare buffer kept");
+            // The bounds are written where the last build's bounds were (no new buffer).
+            buffers.push(bp.list.bounds.as_ptr());
+            // Every object moves by a third of the box: too many to mend, a build.
+            for o in &mut objs {
+                o.center.x = (o.center.x + 33.0).rem_euclid(100.0);
+            }
+        }
+        assert_eq!(buffers[1], buffers[0]);
+        assert_eq!(buffers[2], buffers[0]);
     }
 
     #[test]

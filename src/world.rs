@@ -697,6 +697,12 @@ impl<V: Vector> World<V> {
         Ok(id)
     }
 
+    /// Makes room for `additional` more critters, exactly (for a scene that knows how many it
+    /// will spawn: the critters' storage then does not grow by doubling).
+    pub fn reserve(&mut self, additional: usize) {
+        self.critters.reserve(additional);
+    }
+
     /// Spawns a critter now. Errors name the critter and the bad field; nothing is added then.
     pub fn spawn(&mut self, spec: CritterSpec<V>) -> Result<CritterId, Error> {
         let critter = self.build(spec)?;
