@@ -126,6 +126,24 @@ fn failures_name_file_and_line_and_the_rest_still_run() {
     assert!(xml.contains("tests=\"6\" failures=\"4\""), "{xml}");
     assert_eq!(xml.matches("<testcase ").count(), 6);
     assert_eq!(xml.matches("<failure ").count(), 4);
+
+    // The failed test's run is recorded under the runner's limits, as a world the test built.
+    let file = runs.join("bad-test_wrong_expectation.mcap");
+    let rec = critterbox::recording::Recording::open(&file).expect("the failed run is recorded");
+    assert_eq!(rec.meta().limits.max_operations, 100_000);
+    let case = format!("{}::test_wrong_expectation", dir.join("bad.rhai").display());
+    assert_eq!(
+        rec.meta().source,
+        critterbox::recording::SceneSource::Test { case: case.clone() }
+    );
+    let (code, _, err) = critterbox(&["replay", file.to_str().expect("utf-8")]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, _, err) = critterbox(&["replay", file.to_str().expect("utf-8"), "--verify"]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains(&case) && err.contains("without --verify"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

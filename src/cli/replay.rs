@@ -200,6 +200,7 @@ pub fn summary_head(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> 
             m.n.map_or(String::new(), |n| format!(", n = {n}"))
         ),
         SceneSource::Script { file } => format!("script {file}"),
+        SceneSource::Test { case } => format!("built by the test {case}"),
     };
     writeln!(
         out,

@@ -18,6 +18,13 @@ pub enum SceneSource {
         /// Name of the scene file's attachment (the path it was loaded from).
         file: String,
     },
+    /// A world a test function of `critterbox test` built itself (recorded when the test
+    /// failed): it is replayed from its recorded states, but `replay --verify` cannot rebuild
+    /// it, since the test function, not a scene, made it.
+    Test {
+        /// The test, as `critterbox test` names it (`file::function`).
+        case: String,
+    },
 }
 
 /// How a run was made: everything `replay --verify` needs besides the scripts.
@@ -94,6 +101,10 @@ impl RunMeta {
             SceneSource::Script { file } => {
                 put("scene_source", "script".into());
                 put("scene_file", file.clone());
+            }
+            SceneSource::Test { case } => {
+                put("scene_source", "test".into());
+                put("test_case", case.clone());
             }
         }
         put("seed", self.seed.to_string());
@@ -179,6 +190,9 @@ impl RunMeta {
             "builtin" => SceneSource::Builtin,
             "script" => SceneSource::Script {
                 file: get("scene_file")?.to_string(),
+            },
+            "test" => SceneSource::Test {
+                case: get("test_case")?.to_string(),
             },
             other => return Err(format!("unknown scene_source '{other}'")),
         };

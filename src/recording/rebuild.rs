@@ -78,6 +78,12 @@ pub fn rebuild(rec: &Recording) -> anyhow::Result<Rebuilt> {
             })?;
             (scene, None)
         }
+        SceneSource::Test { case } => anyhow::bail!(
+            "the world of this recording was built by the test {case} (critterbox test \
+             recorded it when the test failed), not by a scene, so it cannot be rebuilt to \
+             verify: replay it without --verify, or run the test again with \
+             `critterbox test FILE --filter NAME`"
+        ),
         SceneSource::Script { file } => {
             let dir = TempDir::new("critterbox-replay")
                 .context("making a temporary folder for the recorded scripts")?;

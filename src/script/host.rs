@@ -215,8 +215,8 @@ pub(crate) struct Host {
     pub deadline: Cell<Option<std::time::Instant>>,
     /// The recording of a test's run (kept only if the test fails).
     pub test_recorder: RefCell<Option<crate::recording::Recorder>>,
-    /// Where a test's run would be recorded; `None` records nothing.
-    pub test_record_path: RefCell<Option<std::path::PathBuf>>,
+    /// Where a test's run would be recorded, and the test's name; `None` records nothing.
+    pub test_record_path: RefCell<Option<(std::path::PathBuf, String)>>,
     /// `critterbox test --bless`: golden recordings are rewritten, not compared.
     pub bless: Cell<bool>,
     /// Set by `world.stop(reason)`.

@@ -170,7 +170,7 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
             .unwrap_or_default();
         dir.join(format!("{stem}-{}.mcap", case.name))
     });
-    *rt.host.test_record_path.borrow_mut() = record_path.clone();
+    *rt.host.test_record_path.borrow_mut() = record_path.clone().map(|p| (p, case.id()));
     let mut scope = Scope::new();
     let result = rt.engine.call_fn_with_options::<Dynamic>(
         rhai::CallFnOptions::new(),
@@ -349,15 +349,21 @@ pub(crate) fn start_recording_pub(host: &Host) -> Res<()> {
 
 /// Starts recording the test's scene, if failures are to be recorded.
 fn start_recording(host: &Host) -> Res<()> {
-    let Some(path) = host.test_record_path.borrow().clone() else {
+    let Some((path, case)) = host.test_record_path.borrow().clone() else {
         return Ok(());
     };
+    let limits = runner_limits(host)?;
     let rec = with_scene(host, |scene| {
-        let meta = crate::cli::record::run_meta(
+        let mut meta = crate::cli::record::run_meta(
             &crate::cli::run::RunArgs::default(),
             scene,
             scene.default_steps,
         );
+        meta.limits = limits.clone();
+        if scene.sources.is_empty() {
+            // Built by the test function itself: no scene to rebuild it from.
+            meta.source = crate::recording::SceneSource::Test { case: case.clone() };
+        }
         crate::recording::Recorder::create(&path, &meta, &scene.sources, &scene.world)
     })?;
     match rec {
@@ -369,6 +375,18 @@ fn start_recording(host: &Host) -> Res<()> {
         ),
     }
     Ok(())
+}
+
+/// The limits the test's scene runs under (the test runner's, not `run`'s defaults), for its
+/// recordings, so that a replay rebuilds the scene under them.
+fn runner_limits(host: &Host) -> Res<crate::script::Limits> {
+    Ok(host
+        .runtime
+        .borrow()
+        .upgrade()
+        .map_or_else(|| fail("the script runtime is gone"), Ok)?
+        .limits
+        .clone())
 }
 
 fn record_step(host: &Host) -> Res<()> {
@@ -388,15 +406,7 @@ fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
     let file = PathBuf::from(path);
     if host.bless.get() {
         let steps = with_scene(host, |s| s.default_steps)?;
-        // The limits the scene runs under (the test runner's, not `run`'s defaults), recorded
-        // so that a replay rebuilds it under them.
-        let limits = host
-            .runtime
-            .borrow()
-            .upgrade()
-            .map_or_else(|| fail("the script runtime is gone"), Ok)?
-            .limits
-            .clone();
+        let limits = runner_limits(host)?;
         let rec = with_scene(host, |scene| {
             let mut meta =
                 crate::cli::record::run_meta(&crate::cli::run::RunArgs::default(), scene, steps);
