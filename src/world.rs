@@ -1087,63 +1087,61 @@ impl<V: Vector> World<V> {
                 (c.pos, c.vel) = topo.apply_at_edges(moved, c.vel, c.radius, c.restitution);
             }
         };
-        {
-            // Each chunk of slots also does the broad phase's input pass, while its critters are
-            // in cache: it surveys them and asks whether each one is still inside its bound of
-            // the Verlet list (at a million critters a pass of its own was another trip through
-            // 128 MB of critters, and the list of objects it read was 40 bytes per critter).
-            // Live walls are counted and left to the broad phase stage, which knows how far to
-            // widen their boxes only when the survey is done. The critters a few slots on are
-            // prefetched: with the check, the loop no longer kept enough loads in flight
-            // (26-28 ms against 18 per step at 1e6 on one thread, docs/performance.md).
-            // Below `PARALLEL_MIN` critters the chunks are taken in turn on this thread (the
-            // same pass: the survey and the check are then not passes of their own either).
-            use rayon::prelude::*;
-            let broad = &self.broad;
-            let parallel = self.critters.len() >= PARALLEL_MIN;
-            let slots = self.critters.slots_mut_moving();
-            let pass = |(k, chunk): (usize, &mut [Option<Critter<V>>])| {
-                let (mut seen, mut held, mut walls) = (Survey::default(), true, 0);
-                for j in 0..chunk.len() {
-                    prefetch(chunk.get(j + MOVE_AHEAD));
-                    let s = &mut chunk[j];
-                    let i = k * INPUT_CHUNK + j;
-                    let Some(c) = s else {
-                        held = held && broad.list_holds(&topo, i, None);
-                        continue;
-                    };
-                    step(i, c);
-                    seen = seen.and(Survey::of(c));
-                    if c.alive && c.is_wall() {
-                        walls += 1;
-                    } else {
-                        held = held && broad.list_holds(&topo, i, broad_object(c, 0.0).as_ref());
-                    }
+        // Each chunk of slots also does the broad phase's input pass, while its critters are
+        // in cache: it surveys them and asks whether each one is still inside its bound of
+        // the Verlet list (at a million critters a pass of its own was another trip through
+        // 128 MB of critters, and the list of objects it read was 40 bytes per critter).
+        // Live walls are counted and left to the broad phase stage, which knows how far to
+        // widen their boxes only when the survey is done. The critters a few slots on are
+        // prefetched: with the check, the loop no longer kept enough loads in flight
+        // (26-28 ms against 18 per step at 1e6 on one thread, docs/performance.md).
+        // Below `PARALLEL_MIN` critters the chunks are taken in turn on this thread (the
+        // same pass: the survey and the check are then not passes of their own either).
+        use rayon::prelude::*;
+        let broad = &self.broad;
+        let parallel = self.critters.len() >= PARALLEL_MIN;
+        let slots = self.critters.slots_mut_moving();
+        let pass = |(k, chunk): (usize, &mut [Option<Critter<V>>])| {
+            let (mut seen, mut held, mut walls) = (Survey::default(), true, 0);
+            for j in 0..chunk.len() {
+                prefetch(chunk.get(j + MOVE_AHEAD));
+                let s = &mut chunk[j];
+                let i = k * INPUT_CHUNK + j;
+                let Some(c) = s else {
+                    held = held && broad.list_holds(&topo, i, None);
+                    continue;
+                };
+                step(i, c);
+                seen = seen.and(Survey::of(c));
+                if c.alive && c.is_wall() {
+                    walls += 1;
+                } else {
+                    held = held && broad.list_holds(&topo, i, broad_object(c, 0.0).as_ref());
                 }
-                (seen, held, walls)
-            };
-            let chunks: Vec<(Survey, bool, usize)> = if parallel {
-                slots
-                    .par_chunks_mut(INPUT_CHUNK)
-                    .enumerate()
-                    .map(pass)
-                    .collect()
-            } else {
-                slots
-                    .chunks_mut(INPUT_CHUNK)
-                    .enumerate()
-                    .map(pass)
-                    .collect()
-            };
-            self.moved = Some(Moved {
-                held: chunks.iter().all(|&(_, held, _)| held),
-                walls: chunks.iter().map(|&(_, _, walls)| walls).sum(),
-                chunks: chunks.len(),
-                seen: chunks
-                    .iter()
-                    .fold(Survey::default(), |s, &(c, _, _)| s.and(c)),
-            });
-        }
+            }
+            (seen, held, walls)
+        };
+        let chunks: Vec<(Survey, bool, usize)> = if parallel {
+            slots
+                .par_chunks_mut(INPUT_CHUNK)
+                .enumerate()
+                .map(pass)
+                .collect()
+        } else {
+            slots
+                .chunks_mut(INPUT_CHUNK)
+                .enumerate()
+                .map(pass)
+                .collect()
+        };
+        self.moved = Some(Moved {
+            held: chunks.iter().all(|&(_, held, _)| held),
+            walls: chunks.iter().map(|&(_, _, walls)| walls).sum(),
+            chunks: chunks.len(),
+            seen: chunks
+                .iter()
+                .fold(Survey::default(), |s, &(c, _, _)| s.and(c)),
+        });
     }
 
     fn stage_broad_phase(&mut self) {
