@@ -809,9 +809,6 @@ pub struct BroadPhase<V: Vector> {
     level_of: Vec<u8>,
     /// The grid's pairs before their exact test, kept between calls (`BroadPhaseMode::Grid`).
     found: Vec<(u32, u32)>,
-    /// During a Verlet list's build, the old bounds' buffer, for the first level built without
-    /// one of its own to hold its boxes in.
-    spare: Vec<CellBox<V>>,
     /// Number of bounding-box tests made in the last call.
     pub tests: u64,
     /// Number of grid levels used in the last call (0 for the direct loop).
@@ -827,7 +824,6 @@ impl<V: Vector> Default for BroadPhase<V> {
             used: Vec::new(),
             level_of: Vec::new(),
             found: Vec::new(),
-            spare: Vec::new(),
             tests: 0,
             levels_used: 0,
         }
@@ -1179,9 +1175,8 @@ impl<V: Vector> BroadPhase<V> {
         pairs.clear();
         // The old bounds' buffer takes the grid's boxes, and the boxes' buffer, once the pairs
         // are found, the new bounds: the two are never kept at once.
-        self.spare = std::mem::take(&mut self.list.bounds);
-        self.grid_padded(&led, topo, &mut pairs, 0.5 * skin);
-        let mut buffer = std::mem::take(&mut self.spare);
+        let mut buffer = std::mem::take(&mut self.list.bounds);
+        self.grid_padded(&led, topo, &mut pairs, 0.5 * skin, &mut buffer);
         for level in &mut self.levels {
             let boxes = level.slim();
             if boxes.capacity() > buffer.capacity() {
@@ -1366,7 +1361,7 @@ impl<V: Vector> BroadPhase<V> {
     ) {
         let mut found = std::mem::take(&mut self.found);
         found.clear();
-        self.grid_padded(objs, topo, &mut found, 0.0);
+        self.grid_padded(objs, topo, &mut found, 0.0, &mut Vec::new());
         self.tests += found.len() as u64;
         out.extend(found.iter().filter_map(|pair| exact(objs, topo, pair)));
         self.found = found;
@@ -1374,13 +1369,15 @@ impl<V: Vector> BroadPhase<V> {
 
     /// The pairs of the grid's cells' boxes (`objs` widened by `pad`, in single precision rounded
     /// outwards: every pair whose widened boxes overlap, and perhaps a few whose boxes only
-    /// touch through the rounding), named by their indices in `objs`.
+    /// touch through the rounding), named by their indices in `objs`. The first level built
+    /// without a buffer of its own for its boxes takes `spare`'s (a Verlet list's old bounds).
     fn grid_padded<O: Objects<V> + ?Sized>(
         &mut self,
         objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
         pad: f64,
+        spare: &mut Vec<CellBox<V>>,
     ) {
         let n = objs.slots();
         assert!(
@@ -1483,7 +1480,7 @@ impl<V: Vector> BroadPhase<V> {
                     })
             };
             if self.levels[l].sorted.capacity() == 0 {
-                std::mem::swap(&mut self.levels[l].sorted, &mut self.spare);
+                std::mem::swap(&mut self.levels[l].sorted, spare);
             }
             floor_cell = self.levels[l].build(members, topo, cell, limit, pad);
         }
@@ -2328,7 +2325,6 @@ mod tests {
                 members += level.members.len();
             }
             assert_eq!(members, objs.len());
-            assert!(bp.spare.capacity() == 0, "no spare buffer kept");
             // The bounds are written where the last build's bounds were (no new buffer).
             buffers.push(bp.list.bounds.as_ptr());
             // Every object moves by a third of the box: too many to mend, a build.
