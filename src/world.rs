@@ -1625,10 +1625,10 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
     }
 
     #[inline]
-    fn stride(&self, i: usize) -> f64 {
+    fn step(&self, i: usize) -> V {
         match self.slots.get(i) {
-            Some(Some(c)) if c.alive && !c.fixed && !c.is_wall() => c.vel.length() * self.dt,
-            _ => 0.0,
+            Some(Some(c)) if c.alive && !c.fixed && !c.is_wall() => c.vel * self.dt,
+            _ => V::zero(),
         }
     }
 }
