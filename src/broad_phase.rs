@@ -297,6 +297,7 @@ impl<V: Vector> Level<V> {
 
     /// Per axis, the first cell and the number of cells of this level whose members may overlap
     /// the box of `b` (members are at most one cell wide). Never more cells than the axis has.
+    #[inline]
     fn footprint(&self, topo: &Topology<V>, b: &CellBox<V>) -> [(i64, usize); 3] {
         let (center, half) = (b.center(), b.half());
         let mut out = [(0i64, 1usize); 3];
@@ -1478,7 +1479,12 @@ impl<V: Vector> BroadPhase<V> {
             let w = width(&o);
             let mut level = 0usize;
             if w > s0 {
-                level = (w / s0).log2().ceil().max(0.0) as usize;
+                // The smallest level whose width holds `w`, from a first guess read off the
+                // ratio's exponent (no call to `log2`).
+                level = ((w / s0).to_bits() >> 52).saturating_sub(1023) as usize;
+                while level > 0 && w <= s0 * pow2(level - 1) {
+                    level -= 1;
+                }
                 while w > s0 * pow2(level) {
                     level += 1;
                 }
@@ -2422,7 +2428,10 @@ mod tests {
             };
             for k in 0..=LEAD_STEPS as usize {
                 let k = k as f64 * 0.999;
-                assert!(bound.holds(&topo, Some(&moved(k))), "{k} steps ahead of {step}");
+                assert!(
+                    bound.holds(&topo, Some(&moved(k))),
+                    "{k} steps ahead of {step}"
+                );
             }
             assert!(
                 !far || !bound.holds(&topo, Some(&moved(-LEAD_STEPS))),
