@@ -603,6 +603,17 @@ impl<V: Vector> Level<V> {
     }
 }
 
+/// After this many builds in a row of a Verlet list that served one step each, pairs are found
+/// with the plain grid (no skin, no list) for [`GRID_SPELL`] steps before a list is tried again.
+/// A pile jostled by the discrete step's separations leaves any skin every step: its list's
+/// skin only added pairs and its re-test repeated the build's tests (the 9-layer pile of the
+/// stress bench took 15 % longer a step than with the plain grid, with the same bits).
+const SHORT_LIVED: u32 = 3;
+
+/// Steps the plain grid is used for once lists are found to live a single step (see
+/// [`SHORT_LIVED`]).
+const GRID_SPELL: u32 = 32;
+
 /// A repair of the Verlet list is refused, and the list built anew, once the objects mended
 /// since the build would pass this share of all objects: each is tested against the others'
 /// new boxes one by one.
@@ -803,6 +814,14 @@ struct PairList<V: Vector> {
     /// median.
     crowded: bool,
     rebuilds: u64,
+    /// Steps the list has served since its build (the build's own included).
+    served: u32,
+    /// Builds in a row that served a single step.
+    short_lived: u32,
+    /// Steps left to find pairs with the plain grid instead of a list (see [`SHORT_LIVED`]).
+    grid_steps: u32,
+    /// Steps found with the plain grid instead of a list.
+    grid_spells: u64,
     /// Indices whose box was made anew by a repair since the build (one bit each): their
     /// entries in the build's levels are stale.
     moved: Vec<u64>,
@@ -823,6 +842,10 @@ impl<V: Vector> Default for PairList<V> {
             sort_wanted: false,
             crowded: false,
             rebuilds: 0,
+            served: 0,
+            short_lived: 0,
+            grid_steps: 0,
+            grid_spells: 0,
             moved: Vec::new(),
             extras: Vec::new(),
             repairs: 0,
@@ -1147,7 +1170,7 @@ impl<V: Vector> BroadPhase<V> {
             self.levels_used = 0;
             self.all_pairs(objs, topo, out);
         } else if self.mode == BroadPhaseMode::Grid {
-            self.grid(objs, topo, out);
+            self.grid(objs, topo, out, &mut Vec::new());
         } else {
             self.listed_pairs(objs, topo, out, held);
         }
@@ -1178,14 +1201,35 @@ impl<V: Vector> BroadPhase<V> {
         out: &mut Vec<(u32, u32)>,
         held: Option<bool>,
     ) {
+        if self.list.grid_steps > 0 {
+            self.list.grid_steps -= 1;
+            self.list.grid_spells += 1;
+            self.plain_grid(objs, topo, out);
+            return;
+        }
         let kept = self.list.valid && self.list.bounds.len() == objs.slots();
         let valid = kept && held.unwrap_or_else(|| self.list_still_valid(objs, topo));
         if !(valid || kept && self.repair_list(objs, topo)) {
+            if self.list.valid && self.list.served <= 1 {
+                self.list.short_lived += 1;
+            } else {
+                self.list.short_lived = 0;
+            }
+            if self.list.short_lived >= SHORT_LIVED {
+                // Built anew every step: the skin only adds pairs, and the re-test repeats
+                // the build's tests. The plain grid for a while, then a list is tried again.
+                self.list.short_lived = 0;
+                self.list.grid_steps = GRID_SPELL - 1;
+                self.list.grid_spells += 1;
+                self.plain_grid(objs, topo, out);
+                return;
+            }
             self.rebuild_list(objs, topo);
         } else if self.list.sort_wanted && !self.list.sorted {
             crate::world::sort_pairs(&mut self.list.pairs, objs.slots());
             self.list.sorted = true;
         }
+        self.list.served = self.list.served.saturating_add(1);
         if objs.slots() >= crate::world::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread count.
             use rayon::prelude::*;
@@ -1268,6 +1312,7 @@ impl<V: Vector> BroadPhase<V> {
         self.list.moved.resize(objs.slots().div_ceil(64), 0);
         self.list.extras.clear();
         self.list.valid = true;
+        self.list.served = 0;
         self.list.rebuilds += 1;
         self.tests = 0;
     }
@@ -1398,6 +1443,12 @@ impl<V: Vector> BroadPhase<V> {
         self.list.repairs
     }
 
+    /// How many calls found their pairs with the plain grid because lists lived a single step
+    /// (diagnostics; see [`SHORT_LIVED`]).
+    pub fn grid_spells(&self) -> u64 {
+        self.list.grid_spells
+    }
+
     fn all_pairs<O: Objects<V> + ?Sized>(
         &mut self,
         objs: &O,
@@ -1416,19 +1467,35 @@ impl<V: Vector> BroadPhase<V> {
     }
 
     /// The grid rebuilt for this call: its cells' single-precision boxes may find a few more
-    /// pairs than overlap, so each is tested again against the exact boxes.
+    /// pairs than overlap, so each is tested again against the exact boxes. The first level
+    /// without a buffer of its own for its boxes takes `spare`'s.
     fn grid<O: Objects<V> + ?Sized>(
         &mut self,
         objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
+        spare: &mut Vec<CellBox<V>>,
     ) {
         let mut found = std::mem::take(&mut self.found);
         found.clear();
-        self.grid_padded(objs, topo, &mut found, 0.0, &mut Vec::new());
+        self.grid_padded(objs, topo, &mut found, 0.0, spare);
         self.tests += found.len() as u64;
         out.extend(found.iter().filter_map(|pair| exact(objs, topo, pair)));
         self.found = found;
+    }
+
+    /// [`Self::grid`] in place of the Verlet list, which is let go (its bounds' buffer handed to
+    /// the grid's boxes).
+    fn plain_grid<O: Objects<V> + ?Sized>(
+        &mut self,
+        objs: &O,
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        self.list.valid = false;
+        self.list.pairs.clear();
+        let mut spare = std::mem::take(&mut self.list.bounds);
+        self.grid(objs, topo, out, &mut spare);
     }
 
     /// The pairs of the grid's cells' boxes (`objs` widened by `pad`, in single precision rounded
@@ -2131,6 +2198,47 @@ mod tests {
             crowd.rebuilds(),
             gas.rebuilds()
         );
+    }
+
+    /// Objects that outrun the skin every step, their steps untold (as a pile jostled by the
+    /// discrete step's separations does): after `SHORT_LIVED` lists of one step each the plain
+    /// grid takes over for `GRID_SPELL` steps, then a list is tried again; every step still
+    /// finds brute force's pairs. A gas that keeps its list never leaves it.
+    #[test]
+    fn lists_that_live_one_step_give_way_to_the_plain_grid_for_a_while() {
+        let (topo, objs, steps) = drifting(13, |_| 0.4);
+        let (slow_topo, slow_objs, slow_steps) = drifting(13, |_| 0.003);
+        let none = [DVec2::ZERO; 1000];
+        let (mut jostled, mut gas) = (
+            BroadPhase::new(BroadPhaseMode::Auto),
+            BroadPhase::new(BroadPhaseMode::Auto),
+        );
+        let turns = 2 * (SHORT_LIVED + GRID_SPELL) as usize;
+        drift(
+            &topo,
+            objs,
+            &steps,
+            turns,
+            &mut [(&mut jostled, &none, false)],
+        );
+        drift(
+            &slow_topo,
+            slow_objs,
+            &slow_steps,
+            turns,
+            &mut [(&mut gas, &none, false)],
+        );
+        // Lists built at steps 0-2, the grid for steps 3-34, lists again at 35-37 (the one at
+        // 35 starts a new run of short lives), the grid from 38 on.
+        let short = u64::from(SHORT_LIVED);
+        assert_eq!(jostled.rebuilds(), 2 * short, "builds");
+        assert_eq!(
+            jostled.grid_spells(),
+            turns as u64 - 2 * short,
+            "steps on the grid"
+        );
+        assert_eq!(gas.grid_spells(), 0);
+        assert_eq!(gas.rebuilds(), 1);
     }
 
     /// Objects with gaps: `None` is a slot with no object.

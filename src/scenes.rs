@@ -117,6 +117,10 @@ impl AnyWorld {
     pub fn broad_phase_repairs(&self) -> u64 {
         both!(self, w => w.broad_phase_repairs())
     }
+    /// How many steps the broad phase used the plain grid because its lists lived one step.
+    pub fn broad_phase_grid_steps(&self) -> u64 {
+        both!(self, w => w.broad_phase_grid_steps())
+    }
     /// Changes the time step.
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         both!(self, w => w.set_dt(dt))

@@ -583,6 +583,11 @@ impl<V: Vector> World<V> {
     pub fn broad_phase_repairs(&self) -> u64 {
         self.broad.repairs()
     }
+    /// How many steps the broad phase found its pairs with the plain grid because its Verlet
+    /// lists lived a single step each (a pile jostled every step; diagnostics).
+    pub fn broad_phase_grid_steps(&self) -> u64 {
+        self.broad.grid_spells()
+    }
     /// The class-pair rule table (diagnostics: how often roles were computed from hooks).
     pub fn rule_cache(&self) -> &RuleCache {
         &self.rules

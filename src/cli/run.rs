@@ -402,12 +402,19 @@ fn stats(
         )?;
     }
     let rebuilds = world.broad_phase_rebuilds();
+    let grid_steps = world.broad_phase_grid_steps();
     if rebuilds > 0 {
         writeln!(
             out,
             "pair list    rebuilt {rebuilds} times (every {:.1} steps), mended {} times",
-            steps as f64 / rebuilds as f64,
+            steps.saturating_sub(grid_steps) as f64 / rebuilds as f64,
             world.broad_phase_repairs()
+        )?;
+    }
+    if grid_steps > 0 {
+        writeln!(
+            out,
+            "plain grid   {grid_steps} steps (the pair lists lived a single step each)"
         )?;
     }
     if let Some(peak) = peak_rss_bytes() {
