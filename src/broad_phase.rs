@@ -819,9 +819,9 @@ struct PairList<V: Vector> {
     /// Builds in a row that served a single step.
     short_lived: u32,
     /// Steps left to find pairs with the plain grid instead of a list (see [`SHORT_LIVED`]).
-    grid_steps: u32,
+    grid_left: u32,
     /// Steps found with the plain grid instead of a list.
-    grid_spells: u64,
+    grid_steps: u64,
     /// Indices whose box was made anew by a repair since the build (one bit each): their
     /// entries in the build's levels are stale.
     moved: Vec<u64>,
@@ -844,8 +844,8 @@ impl<V: Vector> Default for PairList<V> {
             rebuilds: 0,
             served: 0,
             short_lived: 0,
+            grid_left: 0,
             grid_steps: 0,
-            grid_spells: 0,
             moved: Vec::new(),
             extras: Vec::new(),
             repairs: 0,
@@ -1201,9 +1201,9 @@ impl<V: Vector> BroadPhase<V> {
         out: &mut Vec<(u32, u32)>,
         held: Option<bool>,
     ) {
-        if self.list.grid_steps > 0 {
-            self.list.grid_steps -= 1;
-            self.list.grid_spells += 1;
+        if self.list.grid_left > 0 {
+            self.list.grid_left -= 1;
+            self.list.grid_steps += 1;
             self.plain_grid(objs, topo, out);
             return;
         }
@@ -1219,8 +1219,8 @@ impl<V: Vector> BroadPhase<V> {
                 // Built anew every step: the skin only adds pairs, and the re-test repeats
                 // the build's tests. The plain grid for a while, then a list is tried again.
                 self.list.short_lived = 0;
-                self.list.grid_steps = GRID_SPELL - 1;
-                self.list.grid_spells += 1;
+                self.list.grid_left = GRID_SPELL - 1;
+                self.list.grid_steps += 1;
                 self.plain_grid(objs, topo, out);
                 return;
             }
@@ -1445,8 +1445,8 @@ impl<V: Vector> BroadPhase<V> {
 
     /// How many calls found their pairs with the plain grid because lists lived a single step
     /// (diagnostics; see [`SHORT_LIVED`]).
-    pub fn grid_spells(&self) -> u64 {
-        self.list.grid_spells
+    pub fn grid_steps(&self) -> u64 {
+        self.list.grid_steps
     }
 
     fn all_pairs<O: Objects<V> + ?Sized>(
@@ -2233,11 +2233,11 @@ mod tests {
         let short = u64::from(SHORT_LIVED);
         assert_eq!(jostled.rebuilds(), 2 * short, "builds");
         assert_eq!(
-            jostled.grid_spells(),
+            jostled.grid_steps(),
             turns as u64 - 2 * short,
             "steps on the grid"
         );
-        assert_eq!(gas.grid_spells(), 0);
+        assert_eq!(gas.grid_steps(), 0);
         assert_eq!(gas.rebuilds(), 1);
     }
 

@@ -586,7 +586,7 @@ impl<V: Vector> World<V> {
     /// How many steps the broad phase found its pairs with the plain grid because its Verlet
     /// lists lived a single step each (a pile jostled every step; diagnostics).
     pub fn broad_phase_grid_steps(&self) -> u64 {
-        self.broad.grid_spells()
+        self.broad.grid_steps()
     }
     /// The class-pair rule table (diagnostics: how often roles were computed from hooks).
     pub fn rule_cache(&self) -> &RuleCache {
