@@ -306,8 +306,12 @@ impl<V: Vector> Level<V> {
             if n == 1 {
                 continue;
             }
-            let margin = half.get(axis) + 0.5 / self.inv_cell[axis];
             let origin = topo.min.get(axis);
+            // A member's box reaches at most half a cell from its centre's cell. The sums below
+            // round, and a member on the footprint's edge may touch `b` exactly: a billionth
+            // more keeps it in.
+            let reach = half.get(axis) + 0.5 / self.inv_cell[axis];
+            let margin = reach + 1e-9 * ((center.get(axis) - origin).abs() + reach);
             let cell_of = |x: f64| floor_to_i64((x - origin) * self.inv_cell[axis]);
             let (first, last) = (
                 cell_of(center.get(axis) - margin),
