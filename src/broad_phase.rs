@@ -57,11 +57,6 @@ pub(crate) trait Objects<V: Vector>: Sync {
     fn step(&self, _i: usize) -> V {
         V::zero()
     }
-    /// The length of [`Objects::step`].
-    #[inline]
-    fn stride(&self, i: usize) -> f64 {
-        self.step(i).length()
-    }
     /// True when the object at index `i` stays where it is this step and needs no test against
     /// another such object (a sleeper or a wall, src/method/sleep.rs): the kept Verlet list
     /// drops their pairs without reading the objects.
@@ -497,8 +492,9 @@ impl<V: Vector> Level<V> {
         tests
     }
 
-    /// Offsets to visit: `forward` = only those after (0,0,0) in (z, y, x) order.
-    fn offsets(&self, forward: bool) -> Vec<[i32; 3]> {
+    /// The neighbour offsets after (0,0,0) in (z, y, x) order: the forward half a cell's pairs
+    /// are found with.
+    fn forward_offsets(&self) -> Vec<[i32; 3]> {
         let range = |axis: usize| -> Vec<i32> {
             if axis < V::DIM && self.dims[axis] > 1 {
                 vec![-1, 0, 1]
@@ -510,8 +506,7 @@ impl<V: Vector> Level<V> {
         for &z in &range(2) {
             for &y in &range(1) {
                 for &x in &range(0) {
-                    let after = (z, y, x) > (0, 0, 0);
-                    if !forward || after {
+                    if (z, y, x) > (0, 0, 0) {
                         out.push([x, y, z]);
                     }
                 }
@@ -694,7 +689,7 @@ fn sample_median<V: Vector, O: Objects<V> + ?Sized>(
 /// The median stride of the objects that are not walls among the same sample as
 /// [`typical_width`]'s (0 for none).
 fn typical_stride<V: Vector, O: Objects<V> + ?Sized>(objs: &O) -> f64 {
-    sample_median(objs, |i, _| objs.stride(i)).unwrap_or(0.0)
+    sample_median(objs, |i, _| objs.step(i).length()).unwrap_or(0.0)
 }
 
 /// Where one index's object may be while the Verlet list stays valid: its box at the build widened
@@ -1633,7 +1628,7 @@ impl<V: Vector> BroadPhase<V> {
         // the one walk, for any thread count.
         for &l in &used {
             let level = &self.levels[l];
-            let forward = level.offsets(true);
+            let forward = level.forward_offsets();
             let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
             let walk = |run: std::ops::Range<usize>, out: &mut Vec<(u32, u32)>| {
                 level.pairs_within(topo, &forward, &deltas, run, out)
@@ -2440,7 +2435,7 @@ mod tests {
             level.cell_runs(RUN_OBJECTS).len() > RUNS_AT_ONCE,
             "more runs than are walked at once"
         );
-        let forward = level.offsets(true);
+        let forward = level.forward_offsets();
         let deltas: Vec<isize> = forward.iter().map(|&o| level.key_delta(o)).collect();
         let mut whole = Vec::new();
         let tests = level.pairs_within(&topo, &forward, &deltas, 0..objs.len(), &mut whole);
