@@ -32,6 +32,9 @@ pub trait Vector:
     /// What aligns a [`crate::critter::Critter`] of this dimension (a zero-length array of it is
     /// one of its fields): 64 bytes in 2D, so a critter's hot fields share one cache line.
     type CritterAlign: Clone + Copy + Debug + Send + Sync;
+    /// What aligns the event engine's per-critter body (position, velocity, clock, radius: 64
+    /// bytes in 3D, so one body is one cache line, never two; 48 in 2D, left unpadded).
+    type BodyAlign: Clone + Copy + Debug + Default + Send + Sync;
     /// The same number of components in single precision, for compact copies (the broad phase's
     /// cell-sorted boxes and the bounds of its Verlet list).
     type Single: Clone + Copy + Debug + Default + Send + Sync + AsRef<[f32]> + AsMut<[f32]>;
@@ -86,6 +89,7 @@ impl Vector for DVec2 {
     const DIM: usize = 2;
     type Frame = DVec2;
     type CritterAlign = Align64;
+    type BodyAlign = u64;
     type Single = [f32; 2];
 
     #[inline]
@@ -149,6 +153,7 @@ impl Vector for DVec3 {
     const DIM: usize = 3;
     type Frame = DMat3;
     type CritterAlign = u64;
+    type BodyAlign = Align64;
     type Single = [f32; 3];
 
     #[inline]

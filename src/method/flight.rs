@@ -136,7 +136,7 @@ impl Ord for Ev {
 /// are large and scattered); refreshed whenever the flight or a hook changes the critter. 48
 /// bytes in 2D, one cache line in 3D: what a pair test reads and nothing else.
 #[derive(Clone, Copy, Debug, Default)]
-struct Body<V> {
+struct Body<V: Vector> {
     pos: V,
     vel: V,
     /// The body's own clock: `pos` and `vel` hold at this time.
@@ -144,7 +144,14 @@ struct Body<V> {
     /// The radius of a live disk; NaN for a wall or a dead critter (one test sends those to
     /// the general path).
     radius: f64,
+    _align: [V::BodyAlign; 0],
 }
+
+/// A shell's centre and its critter's radius: 32 bytes in 3D, aligned so that one is never
+/// split between two cache lines (a listing reads one per candidate).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+struct Centre<V>(V, f64);
 
 /// The rest of what the flight knows about a critter (16 bytes: one never straddles two
 /// cache lines).
@@ -162,32 +169,54 @@ struct Meta {
     count: u32,
 }
 
-/// The critters in each cell, stored flat: cell `k` owns `data[k * stride..(k + 1) * stride]`,
-/// its count first, then its members. One stripe is one or two cache lines, where a vector per
-/// cell costs a miss for its header and another for its buffer.
+/// The critters in each cell, stored flat: cell `k` owns `stride` entries from
+/// `base + k * stride`, its count first, then its members. The stride is a power of two and
+/// the first stripe starts on a cache line, so a stripe of 16 entries or fewer is one line and
+/// a longer one whole lines, where a vector per cell costs a miss for its header and another
+/// for its buffer.
 #[derive(Default)]
 struct Cells {
     stride: usize,
+    /// Where the first stripe starts in `data` (its first cache-line boundary).
+    base: usize,
     data: Vec<u32>,
 }
 
+/// Entries of `u32` in a cache line.
+const LINE_U32: usize = 64 / std::mem::size_of::<u32>();
+
 impl Cells {
-    /// Empties `total` cells with room for `cap` members each.
+    /// Empties `total` cells with room for `cap` members each (or more: the stripes are
+    /// rounded up to a power of two).
     fn reset(&mut self, total: usize, cap: usize) {
-        self.stride = cap + 1;
+        self.stride = (cap + 1).next_power_of_two();
         self.data.clear();
-        self.data.resize(total * self.stride, 0);
+        self.data.resize(total * self.stride + LINE_U32, 0);
+        let misalign = self.data.as_ptr() as usize % 64 / std::mem::size_of::<u32>();
+        self.base = (LINE_U32 - misalign) % LINE_U32;
+    }
+
+    /// Where cell `k`'s stripe starts in `data`.
+    #[inline]
+    fn start(&self, k: usize) -> usize {
+        self.base + k * self.stride
+    }
+
+    /// The first entry of cell `k`'s stripe, for a prefetch.
+    #[inline]
+    fn head(&self, k: usize) -> Option<&u32> {
+        self.data.get(self.start(k))
     }
 
     #[inline]
     fn members(&self, k: usize) -> &[u32] {
-        let at = k * self.stride;
+        let at = self.start(k);
         let n = self.data[at] as usize;
         &self.data[at + 1..at + 1 + n]
     }
 
     fn push(&mut self, k: usize, a: u32) {
-        let at = k * self.stride;
+        let at = self.start(k);
         let n = self.data[at] as usize;
         if n + 1 == self.stride {
             self.grow();
@@ -198,11 +227,12 @@ impl Cells {
     }
 
     fn clear(&mut self, k: usize) {
-        self.data[k * self.stride] = 0;
+        let at = self.start(k);
+        self.data[at] = 0;
     }
 
     fn remove(&mut self, k: usize, a: u32) {
-        let at = k * self.stride;
+        let at = self.start(k);
         let n = self.data[at] as usize;
         if let Some(i) = self.data[at + 1..at + 1 + n].iter().position(|&x| x == a) {
             self.data[at + 1 + i] = self.data[at + n];
@@ -212,20 +242,21 @@ impl Cells {
 
     /// Doubles every cell's room (a cell filled up: rare, cells are sized for their load).
     fn grow(&mut self) {
-        let (old, stride) = (std::mem::take(&mut self.data), self.stride);
-        let total = old.len() / stride;
-        self.reset(total, 2 * (stride - 1));
+        let (old, stride, base) = (std::mem::take(&mut self.data), self.stride, self.base);
+        let total = (old.len() - LINE_U32) / stride;
+        self.reset(total, 2 * stride - 1);
         for k in 0..total {
-            let n = old[k * stride] as usize;
-            let dst = k * self.stride;
-            self.data[dst..dst + 1 + n].copy_from_slice(&old[k * stride..k * stride + 1 + n]);
+            let from = base + k * stride;
+            let n = old[from] as usize;
+            let dst = self.start(k);
+            self.data[dst..dst + 1 + n].copy_from_slice(&old[from..from + 1 + n]);
         }
     }
 }
 
 /// Per-world scratch kept between steps so a step allocates nothing once warmed up.
 #[derive(Default)]
-pub(crate) struct Scratch<V> {
+pub(crate) struct Scratch<V: Vector> {
     body: Vec<Body<V>>,
     meta: Vec<Meta>,
     cell: Vec<u32>,
@@ -264,7 +295,7 @@ pub(crate) struct Scratch<V> {
     /// Each critter's shell centre (its position when it was last listed) and its radius (the
     /// body's, kept equal by `refresh`; NaN for walls and the dead), side by side so that
     /// listing reads one place per candidate.
-    center: Vec<(V, f64)>,
+    center: Vec<Centre<V>>,
     /// When the critter being predicted leaves its shell (`shell_exit`), found before its
     /// pairs and offered after them.
     exit: Option<f64>,
@@ -323,7 +354,7 @@ pub(crate) struct Scratch<V> {
 /// still count as kept ([`Scratch::churned`]).
 pub const CHURN: f64 = 0.125;
 
-impl<V> Scratch<V> {
+impl<V: Vector> Scratch<V> {
     /// Whether an event step since the last step set up on schedule (the last multiple of
     /// [`FLIGHT_STEPS`] at or before `step`) found its flight churned (see the field). Nothing
     /// before that step counts, so that a run restored there chooses the same.
@@ -1081,7 +1112,8 @@ fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
 fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
     let n = sc.body.len();
     sc.center.clear();
-    sc.center.extend(sc.body.iter().map(|b| (b.pos, b.radius)));
+    sc.center
+        .extend(sc.body.iter().map(|b| Centre(b.pos, b.radius)));
     // Room for the neighbours a random fluid at close packing would give, and some.
     sc.near.reset(n, 24);
     let mut around = [0usize; 27];
@@ -1107,15 +1139,13 @@ fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
 #[inline]
 fn shells_overlap<V: Vector>(
     topo: &Topology<V>,
-    center: &[(V, f64)],
+    center: &[Centre<V>],
     shell: f64,
     a: u32,
     b: u32,
 ) -> bool {
-    let ((ca, ra), (cb, rb)) = (center[a as usize], center[b as usize]);
-    if rb.is_nan() {
-        return false;
-    }
+    let (Centre(ca, ra), Centre(cb, rb)) = (center[a as usize], center[b as usize]);
+    // (A NaN radius, a wall's or the dead's, makes `reach` NaN and the test false.)
     let reach = (ra + rb + shell) * (1.0 + 1e-9);
     topo.delta(ca, cb).length_squared() < reach * reach
 }
@@ -1188,7 +1218,7 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
             }
         }
     }
-    sc.center[ai] = (p, sc.body[ai].radius);
+    sc.center[ai] = Centre(p, sc.body[ai].radius);
     let (new, cc) = cell_of(w, sc, p);
     move_cell(sc, a, old, new, cc);
     let mut around = [0usize; 27];
@@ -1198,7 +1228,7 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     // then the new neighbours' lists.
     use crate::world::prefetch;
     for &k in &around[..count] {
-        prefetch(sc.cells.data.get(k * sc.cells.stride));
+        prefetch(sc.cells.head(k));
     }
     let mut gathered = std::mem::take(&mut sc.gathered);
     gathered.clear();
@@ -1208,11 +1238,21 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     for &b in &gathered {
         prefetch(sc.center.get(b as usize));
     }
+    // The candidates kept in place, without a branch on each (about one in seven is kept, in
+    // no order a processor can predict).
+    let mut kept = 0;
+    for i in 0..gathered.len() {
+        let b = gathered[i];
+        let hit = (b != a) & shells_overlap(&w.topo, &sc.center, sc.shell, a, b);
+        gathered[kept] = b;
+        kept += usize::from(hit);
+    }
+    gathered.truncate(kept);
     for &b in &gathered {
-        if b != a && shells_overlap(&w.topo, &sc.center, sc.shell, a, b) {
-            sc.near.push(ai, b);
-            prefetch(sc.near.data.get(b as usize * sc.near.stride));
-        }
+        prefetch(sc.near.head(b as usize));
+    }
+    for &b in &gathered {
+        sc.near.push(ai, b);
     }
     // `a`'s new neighbours, each joined by `a` unless it kept `a` from before.
     // (By index: a push may grow the stripes and move `a`'s.)
@@ -1302,43 +1342,37 @@ fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) 
 /// Copies critter `a` into its body (after the flight or a hook changed it).
 #[inline]
 fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
-    let t = sc.body[a as usize].t;
-    let count = sc.meta[a as usize].count;
-    let (body, meta) = match w.critters.slot(a) {
-        Some(c) => (
-            Body {
-                pos: c.pos,
-                vel: c.vel,
-                t,
-                radius: if c.alive && !c.is_wall() {
-                    c.radius
-                } else {
-                    f64::NAN
-                },
-            },
-            Meta {
-                free: !c.fixed && !c.is_wall(),
-                alive: c.alive,
-                wall: c.is_wall(),
-                class: c.class,
-                count,
-            },
-        ),
-        None => (
-            Body {
+    // Field by field into place: a body built whole on the stack and copied was read back
+    // across two of its stores (a stall on every collision).
+    let (body, meta) = (&mut sc.body[a as usize], &mut sc.meta[a as usize]);
+    match w.critters.slot(a) {
+        Some(c) => {
+            body.pos = c.pos;
+            body.vel = c.vel;
+            body.radius = if c.alive && !c.is_wall() {
+                c.radius
+            } else {
+                f64::NAN
+            };
+            meta.free = !c.fixed && !c.is_wall();
+            meta.alive = c.alive;
+            meta.wall = c.is_wall();
+            meta.class = c.class;
+        }
+        None => {
+            *body = Body {
                 radius: f64::NAN,
                 ..Body::default()
-            },
-            Meta {
-                count,
+            };
+            *meta = Meta {
+                count: meta.count,
                 ..Meta::default()
-            },
-        ),
-    };
-    sc.body[a as usize] = body;
-    sc.meta[a as usize] = meta;
+            };
+        }
+    }
+    let radius = body.radius;
     if let Some(c) = sc.center.get_mut(a as usize) {
-        c.1 = body.radius; // (unread without shells)
+        c.1 = radius; // (unread without shells)
     }
 }
 
@@ -1393,10 +1427,11 @@ fn prefetch_event<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) {
         let x = x as usize;
         prefetch(sc.body.get(x));
         prefetch(sc.center.get(x));
-        prefetch(slots.get(x));
+        crate::world::prefetch_whole(slots.get(x));
         prefetch(sc.meta.get(x));
-        prefetch(sc.near.data.get(x * sc.near.stride));
-        prefetch(sc.near.data.get(x * sc.near.stride + 16));
+        let at = sc.near.start(x);
+        prefetch(sc.near.data.get(at));
+        prefetch(sc.near.data.get(at + LINE_U32));
     }
 }
 
@@ -1465,7 +1500,13 @@ fn predict_all<V: Vector>(
     sc.cand = None;
     sc.predictions += 1;
     let mine = state_at(sc, a, t);
-    let home = sc.cell[a as usize] as usize;
+    // With shells there are no walls, and the cell is not read (a load spared: a miss, as
+    // often as not, in a large gas).
+    let home = if sc.shells {
+        0
+    } else {
+        sc.cell[a as usize] as usize
+    };
     if sc.shells {
         // The list copied out, so the loop does not find it again in `near` for every partner
         // (predicting needs the flight mutably), and the partners' bodies asked for at once.
@@ -1621,11 +1662,25 @@ fn predict_disk<V: Vector>(
     let (pa, va, _) = mine;
     let d = w.topo.delta(pa, pb);
     let r = (sc.body[a as usize].radius + sc.body[b as usize].radius) * (1.0 - SKIN);
+    // As in `predict_straight_partners`: `toi_ball_ball_by`'s dropping tests first, without
+    // branches, and with the best event so far as the bound (what meets later is dropped
+    // below anyway).
+    let rel = vb - va;
+    let (dot, gap) = (d.dot(rel), d.length_squared() - r * r);
+    let early = match sc.cand {
+        Some(c) => horizon.min((c.time - t) + 1e-12 * (c.time.abs() + t.abs())),
+        None => horizon,
+    };
+    let bound = -2.0 * dot * early;
+    let later = (dot >= 0.0) | (bound.is_normal() & (gap > bound * (1.0 + 1e-9)));
+    if later & (d.length_squared() >= r * r) {
+        return Ok(());
+    }
     let s = if d.length_squared() < r * r {
         0.0 // overlapping: collide now (approaching or not)
     } else {
         // Contacts past the horizon are dropped below; most are found so without a root.
-        match toi_ball_ball_by(d, vb - va, r, horizon) {
+        match toi_ball_ball_by(d, rel, r, horizon) {
             Some(s) => s,
             None => return Ok(()),
         }
@@ -1677,10 +1732,21 @@ fn predict_straight_partners<V: Vector>(
         let pb = body.pos + body.vel * (t - body.t);
         let d = topo.delta(pa, pb);
         let r = (ra + body.radius) * (1.0 - SKIN);
+        // Most pairs are dropped, by `toi_ball_ball_by`'s first or third test, in no order a
+        // processor can predict: those tests first, without branches, for one branch that is
+        // nearly always taken. (The same tests on the same values: what passes meets them
+        // again below.)
+        let rel = body.vel - va;
+        let (dot, gap) = (d.dot(rel), d.length_squared() - r * r);
+        let bound = -2.0 * dot * early;
+        let later = (dot >= 0.0) | (bound.is_normal() & (gap > bound * (1.0 + 1e-9)));
+        if later & (d.length_squared() >= r * r) {
+            continue;
+        }
         let s = if d.length_squared() < r * r {
             0.0 // overlapping: collide now (approaching or not)
         } else {
-            match toi_ball_ball_by(d, body.vel - va, r, early) {
+            match toi_ball_ball_by(d, rel, r, early) {
                 Some(s) => s,
                 None => continue,
             }
@@ -2050,7 +2116,7 @@ fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32
 }
 
 /// Moves `a` from cell `old` to cell `new`, at coordinates `cc`.
-fn move_cell<V>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize, cc: [i64; 3]) {
+fn move_cell<V: Vector>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize, cc: [i64; 3]) {
     if old == new {
         return;
     }
@@ -2178,6 +2244,49 @@ mod tests {
         w.set_method(Method::Event).expect("event");
         w.flight.no_shells = no_shells;
         w
+    }
+
+    /// A stripe of cells or of a neighbour list starts on a cache line (16 entries or fewer are
+    /// one line), before and after the stripes grow, and growing keeps every member; a 3D body
+    /// is one whole line and a shell's centre half of one.
+    #[test]
+    fn stripes_and_bodies_lie_on_cache_lines() {
+        let line = |cells: &super::Cells, k: usize| {
+            (cells.data.as_ptr() as usize + 4 * cells.start(k)) % 64
+        };
+        let mut cells = super::Cells::default();
+        cells.reset(40, 5);
+        assert_eq!(
+            cells.stride, 8,
+            "room for 5 and the count, rounded up to a power of two"
+        );
+        assert!((0..40).all(|k| line(&cells, k) % 32 == 0));
+        assert_eq!(line(&cells, 0), 0);
+        for k in 0..40 {
+            for m in 0..(k % 7) as u32 {
+                cells.push(k, 1000 * k as u32 + m);
+            }
+        }
+        // Cell 6 filled past its room for 7: every stripe grew.
+        cells.push(6, 6006);
+        cells.push(6, 6007);
+        assert_eq!(cells.stride, 16);
+        assert!((0..40).all(|k| line(&cells, k) == 0));
+        for k in 0..40 {
+            let mut want: Vec<u32> = (0..(k % 7) as u32).map(|m| 1000 * k as u32 + m).collect();
+            if k == 6 {
+                want.extend([6006, 6007]);
+            }
+            assert_eq!(cells.members(k), &want[..], "cell {k}");
+        }
+        cells.remove(6, 6001);
+        assert_eq!(cells.members(6).len(), 7);
+        assert!(!cells.members(6).contains(&6001));
+        assert_eq!(std::mem::size_of::<super::Body<DVec3>>(), 64);
+        assert_eq!(std::mem::align_of::<super::Body<DVec3>>(), 64);
+        assert_eq!(std::mem::size_of::<super::Body<glam::DVec2>>(), 48);
+        assert_eq!(std::mem::size_of::<super::Centre<DVec3>>(), 32);
+        assert_eq!(std::mem::align_of::<super::Centre<DVec3>>(), 32);
     }
 
     /// Shells and cells are two ways of finding the same collisions: over a few collisions per
