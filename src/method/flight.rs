@@ -1429,9 +1429,7 @@ fn prefetch_event<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) {
         prefetch(sc.center.get(x));
         crate::world::prefetch_whole(slots.get(x));
         prefetch(sc.meta.get(x));
-        let at = sc.near.start(x);
-        prefetch(sc.near.data.get(at));
-        prefetch(sc.near.data.get(at + LINE_U32));
+        prefetch(sc.near.head(x));
     }
 }
 
