@@ -1263,6 +1263,10 @@ impl<V: Vector> World<V> {
                     walls: &mut Vec<(u32, u32, bool)>|
          -> Option<usize> {
             let mut ruled = 0;
+            // Every disk pair is written and the end moved on only for those that touch: in a
+            // gas most candidates do not, in no order a processor could predict.
+            let mut end = contacts.len();
+            contacts.resize(end + chunk.len(), (0, 0));
             for (k, &(a, b)) in chunk.iter().enumerate() {
                 if let Some(&(i, j)) = chunk.get(k + CANDIDATES_AHEAD) {
                     prefetch(slots.get(i as usize));
@@ -1283,17 +1287,20 @@ impl<V: Vector> World<V> {
                 if first.is_wall() || second.is_wall() {
                     // Tested in the response, once the disk pairs have moved.
                     walls.push((pair.0, pair.1, ask));
-                } else if crate::contact::touching_ball_ball(
-                    topo.delta(first.pos, second.pos),
-                    first.radius,
-                    second.radius,
-                ) {
-                    if ask {
+                } else {
+                    let touching = crate::contact::touching_ball_ball(
+                        topo.delta(first.pos, second.pos),
+                        first.radius,
+                        second.radius,
+                    );
+                    if ask & touching {
                         return None;
                     }
-                    contacts.push(pair);
+                    contacts[end] = pair;
+                    end += usize::from(touching);
                 }
             }
+            contacts.truncate(end);
             Some(ruled)
         };
         self.contacts.clear();
