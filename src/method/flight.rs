@@ -44,7 +44,9 @@ use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
 use crate::method::pair_key;
 use crate::method::queue::{Owned, Queue};
-use crate::method::toi::{smallest_nonneg_root, toi_ball_ball, toi_ball_ball_by, toi_wall_ball};
+use crate::method::toi::{
+    smallest_nonneg_root, surely_no_toi_by, toi_ball_ball, toi_ball_ball_by, toi_wall_ball,
+};
 use crate::rules::PairRule;
 use crate::vector::Vector;
 use crate::world::{at_step, roles_order, StepStats, World};
@@ -1664,14 +1666,11 @@ fn predict_disk<V: Vector>(
     // branches, and with the best event so far as the bound (what meets later is dropped
     // below anyway).
     let rel = vb - va;
-    let (dot, gap) = (d.dot(rel), d.length_squared() - r * r);
     let early = match sc.cand {
         Some(c) => horizon.min((c.time - t) + 1e-12 * (c.time.abs() + t.abs())),
         None => horizon,
     };
-    let bound = -2.0 * dot * early;
-    let later = (dot >= 0.0) | (bound.is_normal() & (gap > bound * (1.0 + 1e-9)));
-    if later & (d.length_squared() >= r * r) {
+    if surely_no_toi_by(d, rel, r, early) {
         return Ok(());
     }
     let s = if d.length_squared() < r * r {
@@ -1730,15 +1729,10 @@ fn predict_straight_partners<V: Vector>(
         let pb = body.pos + body.vel * (t - body.t);
         let d = topo.delta(pa, pb);
         let r = (ra + body.radius) * (1.0 - SKIN);
-        // Most pairs are dropped, by `toi_ball_ball_by`'s first or third test, in no order a
-        // processor can predict: those tests first, without branches, for one branch that is
-        // nearly always taken. (The same tests on the same values: what passes meets them
-        // again below.)
+        // Most pairs are dropped, in no order a processor can predict: first by the tests
+        // that drop them, without a branch on each (`surely_no_toi_by`).
         let rel = body.vel - va;
-        let (dot, gap) = (d.dot(rel), d.length_squared() - r * r);
-        let bound = -2.0 * dot * early;
-        let later = (dot >= 0.0) | (bound.is_normal() & (gap > bound * (1.0 + 1e-9)));
-        if later & (d.length_squared() >= r * r) {
+        if surely_no_toi_by(d, rel, r, early) {
             continue;
         }
         let s = if d.length_squared() < r * r {
