@@ -1666,10 +1666,7 @@ fn predict_disk<V: Vector>(
     // branches, and with the best event so far as the bound (what meets later is dropped
     // below anyway).
     let rel = vb - va;
-    let early = match sc.cand {
-        Some(c) => horizon.min((c.time - t) + 1e-12 * (c.time.abs() + t.abs())),
-        None => horizon,
-    };
+    let early = look_ahead(horizon, t, sc.cand.map_or(f64::INFINITY, |c| c.time));
     if surely_no_toi_by(d, rel, r, early) {
         return Ok(());
     }
@@ -1686,6 +1683,15 @@ fn predict_disk<V: Vector>(
         return Ok(());
     }
     offer_pair(w, sc, a, b, t, s, PAIR)
+}
+
+/// How far from `t` a pair test must look when the best event so far is at `limit`: to the
+/// horizon, or a little past `limit` (1e-12 of the times, far above their rounding), so that a
+/// pair dropped beyond it surely meets later, and ties are kept. An infinite `limit` (no event
+/// yet) gives the horizon.
+#[inline]
+fn look_ahead(horizon: f64, t: f64, limit: f64) -> f64 {
+    horizon.min((limit - t) + 1e-12 * (limit.abs() + t.abs()))
 }
 
 /// [`predict_disk`] for each of `partners` when every flight is straight: the same tests in
@@ -1713,7 +1719,7 @@ fn predict_straight_partners<V: Vector>(
     // it (1e-12 of the times, far above their rounding), so that what it drops is surely later.
     let exit = sc.exit.unwrap_or(f64::INFINITY);
     let best = |sc: &Scratch<V>| sc.cand.map_or(f64::INFINITY, |c| c.time).min(exit);
-    let reach = |limit: f64| horizon.min((limit - t) + 1e-12 * (limit.abs() + t.abs()));
+    let reach = |limit: f64| look_ahead(horizon, t, limit);
     let mut limit = best(sc);
     let mut early = reach(limit);
     let mut tests = 0;
