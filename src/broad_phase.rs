@@ -1027,6 +1027,19 @@ fn merge_tail(pairs: &mut Vec<(u32, u32)>, start: usize) {
     }
 }
 
+/// What a caller that checked each object against the Verlet list while it had it at hand (the
+/// world, in its move) found: the indices [`BroadPhase::list_holds`] said no for. A repair then
+/// mends those without another pass over every object (at a million critters, a trip through
+/// 128 MB).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Escapes {
+    /// The indices whose object left its bound, ascending.
+    pub(crate) slots: Vec<u32>,
+    /// False when not every escaped index is in `slots` (the caller stopped noting them, or did
+    /// not check every index): the broad phase then checks every object itself.
+    pub(crate) complete: bool,
+}
+
 /// The tag bit of a wall's [`CellBox`] and [`Bound`].
 const WALL: u32 = 1 << 31;
 
@@ -1147,16 +1160,15 @@ impl<V: Vector> BroadPhase<V> {
         self.find_pairs_in(objs, topo, out, None);
     }
 
-    /// [`Self::find_pairs`] for any [`Objects`]. `held` is what the caller already knows of the
-    /// Verlet list: `Some(true)` when [`Self::list_holds`] said yes for every index of `objs`,
-    /// `Some(false)` when it said no for one, `None` when it was not asked (the check is then
-    /// made here).
+    /// [`Self::find_pairs`] for any [`Objects`]. `escapes` is what the caller already knows of
+    /// the Verlet list: the indices of `objs` for which [`Self::list_holds`] said no, or `None`
+    /// when it was not asked (the check is then made here).
     pub(crate) fn find_pairs_in<O: Objects<V> + ?Sized>(
         &mut self,
         objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
-        held: Option<bool>,
+        escapes: Option<Escapes>,
     ) {
         out.clear();
         self.tests = 0;
@@ -1172,13 +1184,14 @@ impl<V: Vector> BroadPhase<V> {
         } else if self.mode == BroadPhaseMode::Grid {
             self.grid(objs, topo, out, &mut Vec::new());
         } else {
-            self.listed_pairs(objs, topo, out, held);
+            self.listed_pairs(objs, topo, out, escapes);
         }
     }
 
     /// True when the kept Verlet list still covers index `i` holding `o`: for a caller that
     /// checks each object while it has it at hand (the world, in its move) and passes the
-    /// verdict to [`Self::find_pairs_in`]. False when there is no list.
+    /// indices it said no for to [`Self::find_pairs_in`] ([`Escapes`]). False when there is no
+    /// list.
     #[inline]
     pub(crate) fn list_holds(
         &self,
@@ -1199,7 +1212,7 @@ impl<V: Vector> BroadPhase<V> {
         objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
-        held: Option<bool>,
+        escapes: Option<Escapes>,
     ) {
         if self.list.grid_left > 0 {
             self.list.grid_left -= 1;
@@ -1208,8 +1221,14 @@ impl<V: Vector> BroadPhase<V> {
             return;
         }
         let kept = self.list.valid && self.list.bounds.len() == objs.slots();
-        let valid = kept && held.unwrap_or_else(|| self.list_still_valid(objs, topo));
-        if !(valid || kept && self.repair_list(objs, topo)) {
+        // The escaped indices when the caller noted them all, else found by a pass of our own.
+        let (valid, known) = match escapes {
+            _ if !kept => (false, None),
+            Some(e) if e.complete => (e.slots.is_empty(), Some(e.slots)),
+            Some(_) => (false, None),
+            None => (self.list_still_valid(objs, topo), None),
+        };
+        if !(valid || kept && self.repair_list(objs, topo, known)) {
             if self.list.valid && self.list.served <= 1 {
                 self.list.short_lived += 1;
             } else {
@@ -1325,15 +1344,22 @@ impl<V: Vector> BroadPhase<V> {
     /// and one or two such disks made the list be rebuilt most steps. Returns false, having
     /// changed nothing, when a build is due: more than [`REPAIR_SHARE`] of the objects mended
     /// since the build, or more work than [`REPAIR_WORK`] allows.
-    fn repair_list<O: Objects<V> + ?Sized>(&mut self, objs: &O, topo: &Topology<V>) -> bool {
+    fn repair_list<O: Objects<V> + ?Sized>(
+        &mut self,
+        objs: &O,
+        topo: &Topology<V>,
+        known: Option<Vec<u32>>,
+    ) -> bool {
         let n = objs.slots();
         let bounds = &self.list.bounds;
         let out = |i: usize| (!bounds[i].holds(topo, objs.object(i).as_ref())).then_some(i as u32);
-        let escaped: Vec<u32> = if n >= crate::world::PARALLEL_MIN {
-            use rayon::prelude::*;
-            (0..n).into_par_iter().filter_map(out).collect()
-        } else {
-            (0..n).filter_map(out).collect()
+        let escaped: Vec<u32> = match known {
+            Some(escaped) => escaped,
+            None if n >= crate::world::PARALLEL_MIN => {
+                use rayon::prelude::*;
+                (0..n).into_par_iter().filter_map(out).collect()
+            }
+            None => (0..n).filter_map(out).collect(),
         };
         let (e, x) = (escaped.len(), self.list.extras.len());
         if e == 0 || (e + x) as f64 > REPAIR_SHARE * n as f64 {

@@ -16,7 +16,7 @@
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
 use crate::border::{Border, Topology};
-use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode, Objects};
+use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode, Escapes, Objects};
 use crate::contact::contact_wall_ball;
 use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
 use crate::critter::{
@@ -1106,14 +1106,27 @@ impl<V: Vector> World<V> {
         let broad = &self.broad;
         let parallel = self.critters.len() >= PARALLEL_MIN;
         let slots = self.critters.slots_mut_moving();
+        // The slots that left their bound are noted, up to an eighth of a chunk (a repair mends
+        // at most a 32nd of all), so that a repair need not look for them again.
         let pass = |(k, chunk): (usize, &mut [Option<Critter<V>>])| {
-            let (mut seen, mut held, mut walls) = (Survey::default(), true, 0);
+            let (mut seen, mut walls) = (Survey::default(), 0);
+            let mut escapes = Escapes {
+                slots: Vec::new(),
+                complete: true,
+            };
+            let most = chunk.len() / 8 + 1;
+            let mut note = |i: usize, o: Option<&BroadObject<V>>| {
+                if escapes.complete && !broad.list_holds(&topo, i, o) {
+                    escapes.complete = escapes.slots.len() < most;
+                    escapes.slots.push(i as u32);
+                }
+            };
             for j in 0..chunk.len() {
                 prefetch(chunk.get(j + MOVE_AHEAD));
                 let s = &mut chunk[j];
                 let i = k * INPUT_CHUNK + j;
                 let Some(c) = s else {
-                    held = held && broad.list_holds(&topo, i, None);
+                    note(i, None);
                     continue;
                 };
                 step(i, c);
@@ -1121,12 +1134,12 @@ impl<V: Vector> World<V> {
                 if c.alive && c.is_wall() {
                     walls += 1;
                 } else {
-                    held = held && broad.list_holds(&topo, i, broad_object(c, 0.0).as_ref());
+                    note(i, broad_object(c, 0.0).as_ref());
                 }
             }
-            (seen, held, walls)
+            (seen, escapes, walls)
         };
-        let chunks: Vec<(Survey, bool, usize)> = if parallel {
+        let chunks: Vec<(Survey, Escapes, usize)> = if parallel {
             slots
                 .par_chunks_mut(INPUT_CHUNK)
                 .enumerate()
@@ -1139,8 +1152,17 @@ impl<V: Vector> World<V> {
                 .map(pass)
                 .collect()
         };
+        let mut escapes = Escapes {
+            slots: Vec::new(),
+            complete: chunks.iter().all(|(_, e, _)| e.complete),
+        };
+        if escapes.complete {
+            for (_, e, _) in &chunks {
+                escapes.slots.extend_from_slice(&e.slots);
+            }
+        }
         self.moved = Some(Moved {
-            held: chunks.iter().all(|&(_, held, _)| held),
+            escapes,
             walls: chunks.iter().map(|&(_, _, walls)| walls).sum(),
             chunks: chunks.len(),
             seen: chunks
@@ -1182,21 +1204,29 @@ impl<V: Vector> World<V> {
         };
         // The move checked every slot but the live walls' against the Verlet list; the walls
         // are checked here, and must be the ones it counted.
-        let held = moved.map(|m| {
-            let mut walls = 0;
-            let walls_held = self.walls.iter().all(|&id| match self.critters.get(id) {
-                Some(c) if c.alive && c.is_wall() => {
+        let escapes = moved.map(|m| {
+            let mut escapes = m.escapes;
+            let (mut walls, disks) = (0, escapes.slots.len());
+            for &id in &self.walls {
+                if let Some(c) = self.critters.get(id).filter(|c| c.alive && c.is_wall()) {
                     walls += 1;
                     let i = id.index as usize;
-                    self.broad
+                    if !self
+                        .broad
                         .list_holds(&self.topo, i, objs.object(i).as_ref())
+                    {
+                        escapes.slots.push(c.id.index);
+                    }
                 }
-                _ => true,
-            });
-            m.held && walls_held && walls == m.walls
+            }
+            if escapes.slots.len() > disks {
+                escapes.slots.sort_unstable();
+            }
+            escapes.complete &= walls == m.walls;
+            escapes
         });
         self.broad
-            .find_pairs_in(&objs, &self.topo, &mut self.candidates, held);
+            .find_pairs_in(&objs, &self.topo, &mut self.candidates, escapes);
     }
 
     fn stage_rules(&mut self) -> Result<(), Error> {
@@ -1756,15 +1786,15 @@ fn wall_half<V: Vector>(c: &Critter<V>) -> V {
 }
 
 /// What the move stage did for the broad phase's input pass (see [`World::stage_move`]).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Moved {
     /// How many chunks of [`INPUT_CHUNK`] slots it went through.
     chunks: usize,
     /// What it saw of the critters.
     seen: Survey,
-    /// True when every slot but the live walls' was still inside its bound of the broad phase's
-    /// Verlet list.
-    held: bool,
+    /// The slots but the live walls' that were no longer inside their bound of the broad
+    /// phase's Verlet list.
+    escapes: Escapes,
     /// How many live walls it passed over.
     walls: usize,
 }
@@ -1926,6 +1956,69 @@ mod tests {
         };
         assert_eq!(sorted(&w.candidates), sorted(&fresh), "{what}");
         changes(w) > rebuilds
+    }
+
+    /// The slots the move notes as having left their bound of the Verlet list are exactly those
+    /// a full check of every slot finds, in order, so a repair may mend them without a pass of
+    /// its own; and the pairs stay those of a fresh grid through the repairs.
+    #[test]
+    fn the_move_notes_every_slot_that_left_its_bound() {
+        for n in [3_000, PARALLEL_MIN + 5000] {
+            let params = crate::scenes::SceneParams {
+                n: Some(n),
+                ..Default::default()
+            };
+            let crate::scenes::AnyWorld::D2(mut w) = crate::scenes::builtin("gas", &params)
+                .expect("builds")
+                .world
+            else {
+                panic!("gas is 2D")
+            };
+            // A few fast disks leave their bounds every few steps, too few to rebuild for.
+            let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id()).collect();
+            for id in ids.iter().step_by(97) {
+                if let Some(c) = w.get_mut(*id).filter(|c| !c.is_wall()) {
+                    c.vel *= 20.0;
+                }
+            }
+            let (mut noted, mut repairs) = (0, 0);
+            for step in 0..40 {
+                let before = w.broad_phase_repairs();
+                w.stage_move(w.dt);
+                let moved = w.moved.clone().expect("the move ran");
+                let slots = w.critters.slot_slice();
+                let full: Vec<u32> = (0..slots.len())
+                    .filter(|&i| {
+                        let o = slots[i].as_ref().and_then(|c| broad_object(c, 0.0));
+                        !w.broad.list_holds(&w.topo, i, o.as_ref())
+                            && !slots[i].as_ref().is_some_and(|c| c.alive && c.is_wall())
+                    })
+                    .map(|i| i as u32)
+                    .collect();
+                if moved.escapes.complete {
+                    assert_eq!(moved.escapes.slots, full, "n {n}, step {step}");
+                    noted += full.len();
+                }
+                let mut fresh = Vec::new();
+                w.stage_broad_phase();
+                BroadPhase::new(BroadPhaseMode::Grid).find_pairs(
+                    &fresh_objects(&w),
+                    &w.topo,
+                    &mut fresh,
+                );
+                let sorted = |pairs: &[(u32, u32)]| {
+                    let mut v: Vec<_> = pairs.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+                    v.sort_unstable();
+                    v
+                };
+                assert_eq!(sorted(&w.candidates), sorted(&fresh), "n {n}, step {step}");
+                repairs += w.broad_phase_repairs() - before;
+            }
+            assert!(
+                noted > 0 && repairs > 0,
+                "n {n}: {noted} noted, {repairs} repairs"
+            );
+        }
     }
 
     /// Above PARALLEL_MIN the move checks each critter against the Verlet list and the broad
