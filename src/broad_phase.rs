@@ -623,6 +623,9 @@ const REPAIR_SHARE: f64 = 1.0 / 32.0;
 /// this many per object: a build visits a few cells per object on each level.
 const REPAIR_WORK: f64 = 4.0;
 
+/// Objects per task of the pass that finds each object's level on rayon's threads.
+const LEVEL_CHUNK: usize = 8192;
+
 /// Objects per run of cells walked by one task when a level's pairs are found in parallel.
 const RUN_OBJECTS: usize = 8192;
 
@@ -874,6 +877,8 @@ pub struct BroadPhase<V: Vector> {
     /// The levels the last build filled, finest first (the others may hold older builds).
     used: Vec<usize>,
     level_of: Vec<u8>,
+    /// The finest width of the last build (its `s0`), the guess the next one starts from.
+    finest: f64,
     /// The grid's pairs before their exact test, kept between calls (`BroadPhaseMode::Grid`).
     found: Vec<(u32, u32)>,
     /// Number of bounding-box tests made in the last call.
@@ -890,6 +895,7 @@ impl<V: Vector> Default for BroadPhase<V> {
             levels: Vec::new(),
             used: Vec::new(),
             level_of: Vec::new(),
+            finest: 0.0,
             found: Vec::new(),
             tests: 0,
             levels_used: 0,
@@ -1560,26 +1566,14 @@ impl<V: Vector> BroadPhase<V> {
             }
             w
         };
-        // Two passes over the objects (at 1e6 the world's are critters 128 bytes apart), on
-        // rayon's threads for a large scene: a minimum and an indexed map give the same result
-        // for any thread count.
+        // Each object's level is measured from the finest width `s0`, which takes a pass over
+        // the objects of its own (at 1e6 the world's are critters 128 bytes apart). The levels
+        // are first found from the last build's `s0`, in the same pass that finds the new one:
+        // where the two are equal (a scene whose smallest objects stay the same size), that is
+        // the only pass. On rayon's threads for a large scene, in fixed chunks: a minimum and
+        // an indexed map give the same result for any thread count.
         let parallel = n >= crate::world::PARALLEL_MIN;
-        let smallest = |i: usize| objs.object(i).map_or(f64::INFINITY, |o| width(&o));
-        let s0 = if parallel {
-            use rayon::prelude::*;
-            (0..n)
-                .into_par_iter()
-                .map(smallest)
-                .reduce(|| f64::INFINITY, f64::min)
-        } else {
-            (0..n).map(smallest).fold(f64::INFINITY, f64::min)
-        }
-        .max(f64::MIN_POSITIVE);
-        let level = |i: usize| {
-            let Some(o) = objs.object(i) else {
-                return NO_LEVEL;
-            };
-            let w = width(&o);
+        let level_from = |s0: f64, w: f64| {
             let mut level = 0usize;
             if w > s0 {
                 // The smallest level whose width holds `w`, from a first guess read off the
@@ -1595,13 +1589,43 @@ impl<V: Vector> BroadPhase<V> {
             }
             level as u8
         };
-        self.level_of.clear();
-        if parallel {
-            use rayon::prelude::*;
-            self.level_of.par_extend((0..n).into_par_iter().map(level));
-        } else {
-            self.level_of.extend((0..n).map(level));
+        // The levels of the objects from index `start` on, from `s0`; returns their finest width.
+        let levels = |s0: f64, start: usize, out: &mut [u8]| {
+            let mut finest = f64::INFINITY;
+            for (k, at) in out.iter_mut().enumerate() {
+                objs.prefetch(start + k + MEMBERS_AHEAD);
+                *at = match objs.object(start + k) {
+                    Some(o) => {
+                        let w = width(&o);
+                        finest = finest.min(w);
+                        level_from(s0, w)
+                    }
+                    None => NO_LEVEL,
+                };
+            }
+            finest
+        };
+        let mut all_levels = |s0: f64| {
+            self.level_of.clear();
+            self.level_of.resize(n, NO_LEVEL);
+            if parallel {
+                use rayon::prelude::*;
+                self.level_of
+                    .par_chunks_mut(LEVEL_CHUNK)
+                    .enumerate()
+                    .map(|(k, out)| levels(s0, k * LEVEL_CHUNK, out))
+                    .reduce(|| f64::INFINITY, f64::min)
+            } else {
+                levels(s0, 0, &mut self.level_of)
+            }
+            .max(f64::MIN_POSITIVE)
+        };
+        let guess = self.finest;
+        let s0 = all_levels(guess);
+        if s0 != guess {
+            all_levels(s0);
         }
+        self.finest = s0;
         let (mut top, mut count, mut occupied) = (0usize, 0usize, [false; 64]);
         for &l in self.level_of.iter().filter(|&&l| l != NO_LEVEL) {
             top = top.max(usize::from(l));
