@@ -2026,6 +2026,32 @@ mod tests {
         }
     }
 
+    /// A build finds the levels from the last build's finest width and again when the new one
+    /// differs: one grid reused while every object shrinks and grows finds what all pairs find.
+    #[test]
+    fn levels_found_from_the_last_finest_width_are_found_again_when_it_changes() {
+        let mut rng = Rng::new(11);
+        let topo = Topology {
+            min: DVec2::ZERO,
+            max: DVec2::splat(40.0),
+            border: Border::Bounce,
+        };
+        let objs = random_objs::<DVec2>(&mut rng, 600, 40.0, 0.2, 6.0);
+        let mut bp = BroadPhase::new(BroadPhaseMode::Grid);
+        for scale in [1.0, 0.25, 0.25, 3.0, 1.0] {
+            let scaled: Vec<BroadObject<DVec2>> = objs
+                .iter()
+                .map(|o| BroadObject {
+                    half: o.half * scale,
+                    ..*o
+                })
+                .collect();
+            let mut out = Vec::new();
+            bp.find_pairs(&scaled, &topo, &mut out);
+            assert_eq!(normalise(out), brute(&scaled, &topo), "scale {scale}");
+        }
+    }
+
     #[test]
     fn long_walls_over_a_crowd_match_all_pairs() {
         // Few large objects over many small ones: the coarse objects walk the fine cells.
