@@ -1947,6 +1947,12 @@ mod tests {
         let rebuilds = changes(w);
         w.stage_move(w.dt);
         w.stage_broad_phase();
+        assert_fresh_pairs(w, what);
+        changes(w) > rebuilds
+    }
+
+    /// The broad phase's last pairs must be those a fresh grid finds in fresh objects.
+    fn assert_fresh_pairs(w: &World<DVec2>, what: &str) {
         let mut fresh = Vec::new();
         BroadPhase::new(BroadPhaseMode::Grid).find_pairs(&fresh_objects(w), &w.topo, &mut fresh);
         let sorted = |pairs: &[(u32, u32)]| {
@@ -1955,7 +1961,21 @@ mod tests {
             v
         };
         assert_eq!(sorted(&w.candidates), sorted(&fresh), "{what}");
-        changes(w) > rebuilds
+    }
+
+    /// The built-in gas of `n` disks.
+    fn gas_2d(n: usize) -> World<DVec2> {
+        let params = crate::scenes::SceneParams {
+            n: Some(n),
+            ..Default::default()
+        };
+        let crate::scenes::AnyWorld::D2(w) = crate::scenes::builtin("gas", &params)
+            .expect("builds")
+            .world
+        else {
+            panic!("gas is 2D")
+        };
+        w
     }
 
     /// The slots the move notes as having left their bound of the Verlet list are exactly those
@@ -1964,16 +1984,7 @@ mod tests {
     #[test]
     fn the_move_notes_every_slot_that_left_its_bound() {
         for n in [3_000, PARALLEL_MIN + 5000] {
-            let params = crate::scenes::SceneParams {
-                n: Some(n),
-                ..Default::default()
-            };
-            let crate::scenes::AnyWorld::D2(mut w) = crate::scenes::builtin("gas", &params)
-                .expect("builds")
-                .world
-            else {
-                panic!("gas is 2D")
-            };
+            let mut w = gas_2d(n);
             // A few fast disks leave their bounds every few steps, too few to rebuild for.
             let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id()).collect();
             for id in ids.iter().step_by(97) {
@@ -1999,19 +2010,8 @@ mod tests {
                     assert_eq!(moved.escapes.slots, full, "n {n}, step {step}");
                     noted += full.len();
                 }
-                let mut fresh = Vec::new();
                 w.stage_broad_phase();
-                BroadPhase::new(BroadPhaseMode::Grid).find_pairs(
-                    &fresh_objects(&w),
-                    &w.topo,
-                    &mut fresh,
-                );
-                let sorted = |pairs: &[(u32, u32)]| {
-                    let mut v: Vec<_> = pairs.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
-                    v.sort_unstable();
-                    v
-                };
-                assert_eq!(sorted(&w.candidates), sorted(&fresh), "n {n}, step {step}");
+                assert_fresh_pairs(&w, &format!("n {n}, step {step}"));
                 repairs += w.broad_phase_repairs() - before;
             }
             assert!(
@@ -2027,16 +2027,7 @@ mod tests {
     /// always those of a fresh grid.
     #[test]
     fn the_move_s_check_of_the_verlet_list_misses_no_change() {
-        let params = crate::scenes::SceneParams {
-            n: Some(PARALLEL_MIN + 5000),
-            ..Default::default()
-        };
-        let crate::scenes::AnyWorld::D2(mut w) = crate::scenes::builtin("gas", &params)
-            .expect("builds")
-            .world
-        else {
-            panic!("gas is 2D")
-        };
+        let mut w = gas_2d(PARALLEL_MIN + 5000);
         assert!(!w.walls.is_empty(), "the gas has walls");
         assert!(check_pairs(&mut w, "first step"), "the first step builds");
         assert!(
