@@ -517,7 +517,9 @@ impl<V: Vector> Level<V> {
 
     /// Sizes the level's grid for cells at least `cell` wide (and at most `limit` cells), sorts
     /// its members (the objects `members` gives, with their indices) by cell, and returns the cell
-    /// width used. The sorted copies are widened by `pad` and named by their index.
+    /// width used. The sorted copies are widened by `pad` and named by their index. `known`, if
+    /// given, is the members' indices again and every object's cell key in this level's last
+    /// grid: taken where the new grid is the same, in place of a pass over the members.
     fn build<M: Iterator<Item = (u32, BroadObject<V>)>, I: Iterator<Item = usize>>(
         &mut self,
         members: impl Fn() -> M,
@@ -600,8 +602,8 @@ impl<V: Vector> Level<V> {
         self.sorted_keys.resize(m, 0);
         // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
         // the shift below turns ends back into starts.
-        // Each key is found again from the centre (a few operations on what is read anyway)
-        // rather than kept from the count: 4 bytes per member less.
+        // Each key is taken from `known` or found again from the centre (a few operations on
+        // what is read anyway) rather than kept from the count: 4 bytes per member less.
         for (i, o) in members() {
             let k = match &known {
                 Some((_, keys)) => keys[i as usize] as usize,
