@@ -162,6 +162,15 @@ pub enum BroadPhaseMode {
     AllPairs,
 }
 
+/// What a level's build may take instead of a pass over its members (see [`Level::build`]):
+/// their indices again, every object's cell key in the level's last grid, and each object by
+/// its index.
+struct Known<'a, I, F> {
+    indices: I,
+    keys: &'a [u32],
+    object: F,
+}
+
 /// One level of the grid: its cells and its members, copied in cell order.
 struct Level<V: Vector> {
     inv_cell: [f64; 3],
@@ -520,15 +529,21 @@ impl<V: Vector> Level<V> {
     /// width used. The sorted copies are widened by `pad` and named by their index. `known`, if
     /// given, is the members' indices again and every object's cell key in this level's last
     /// grid: taken where the new grid is the same, in place of a pass over the members.
-    fn build<M: Iterator<Item = (u32, BroadObject<V>)>, I: Iterator<Item = usize>>(
+    fn build<M, I, It, F>(
         &mut self,
         members: impl Fn() -> M,
-        known: Option<(impl Fn() -> I, &[u32])>,
+        known: Option<Known<'_, I, F>>,
         topo: &Topology<V>,
         mut cell: f64,
         limit: f64,
         pad: f64,
-    ) -> f64 {
+    ) -> f64
+    where
+        M: Iterator<Item = (u32, BroadObject<V>)>,
+        I: Fn() -> It + Sync,
+        It: Iterator<Item = usize>,
+        F: Fn(usize) -> Option<BroadObject<V>> + Sync,
+    {
         let last = (self.dims, self.inv_cell, self.wrap);
         let size = topo.size();
         loop {
@@ -569,9 +584,16 @@ impl<V: Vector> Level<V> {
         // The members' keys as the caller found them in the last build's grid, if it is this
         // one: the same keys, without reading the members again.
         let known = known.filter(|_| last == (self.dims, self.inv_cell, self.wrap));
+        if let Some(known) = &known {
+            let parts = rayon::current_num_threads().min(FILL_PARTS);
+            if known.keys.len() >= crate::world::PARALLEL_MIN && parts > 1 {
+                self.sort_in_parts(known, parts, pad);
+                return cell;
+            }
+        }
         let mut m = 0;
         match &known {
-            Some((indices, keys)) => {
+            Some(Known { indices, keys, .. }) => {
                 for i in indices() {
                     self.start[keys[i] as usize] += 1;
                     m += 1;
@@ -606,7 +628,7 @@ impl<V: Vector> Level<V> {
         // what is read anyway) rather than kept from the count: 4 bytes per member less.
         for (i, o) in members() {
             let k = match &known {
-                Some((_, keys)) => keys[i as usize] as usize,
+                Some(known) => known.keys[i as usize] as usize,
                 None => self.key(self.coords(topo, o.center)),
             };
             let at = self.start[k] as usize;
@@ -619,6 +641,106 @@ impl<V: Vector> Level<V> {
         }
         self.start[0] = 0;
         cell
+    }
+
+    /// [`Level::build`]'s counting sort with every member's key known, in `parts` ranges of
+    /// cells on rayon's threads. Each part reads every member's key and takes the members of
+    /// its own cells, in index order: the cells come out as the sequential sort fills them, for
+    /// any number of parts. The members are counted in ranges of as many cells, and filled in
+    /// ranges of about as many members (at a million critters one pass through the critters,
+    /// 36 ms a build on one thread, was the sequential part of a build).
+    fn sort_in_parts<I, It, F>(&mut self, known: &Known<'_, I, F>, parts: usize, pad: f64)
+    where
+        I: Fn() -> It + Sync,
+        It: Iterator<Item = usize>,
+        F: Fn(usize) -> Option<BroadObject<V>> + Sync,
+    {
+        use rayon::prelude::*;
+        let Known {
+            indices,
+            keys,
+            object,
+        } = known;
+        let ncells = self.start.len() - 1;
+        let per = ncells.div_ceil(parts).max(1);
+        let m: usize = self.start[..ncells]
+            .par_chunks_mut(per)
+            .enumerate()
+            .map(|(p, counts)| {
+                let cells = p * per..p * per + counts.len();
+                let mut m = 0;
+                for i in indices() {
+                    let k = keys[i] as usize;
+                    if cells.contains(&k) {
+                        counts[k - cells.start] += 1;
+                        m += 1;
+                    }
+                }
+                m
+            })
+            .sum();
+        let mut acc = 0u32;
+        for s in self.start.iter_mut() {
+            let count = *s;
+            *s = acc;
+            acc += count;
+        }
+        self.sorted.clear();
+        self.sorted.resize(m, CellBox::default());
+        if self.sorted_keys.capacity() == 0 {
+            self.sorted_keys = std::mem::take(&mut self.members);
+        }
+        self.sorted_keys.clear();
+        self.sorted_keys.resize(m, 0);
+        // Cells cut where the members before reach each part's share.
+        let mut cuts = vec![0usize];
+        for p in 1..parts {
+            let share = (m * p / parts) as u32;
+            let k = self.start[..ncells].partition_point(|&s| s < share);
+            cuts.push(k.max(cuts[p - 1]));
+        }
+        cuts.push(ncells);
+        let mut jobs = Vec::with_capacity(parts);
+        let (mut start, mut sorted, mut tags) = (
+            &mut self.start[..ncells],
+            &mut self.sorted[..],
+            &mut self.sorted_keys[..],
+        );
+        for w in cuts.windows(2) {
+            let (lo, hi) = (w[0], w[1]);
+            let first = start.first().map_or(m, |&s| s as usize);
+            let end = if hi < ncells {
+                start[hi - lo] as usize
+            } else {
+                m
+            };
+            let (s, rest) = std::mem::take(&mut start).split_at_mut(hi - lo);
+            let (b, rest_b) = std::mem::take(&mut sorted).split_at_mut(end - first);
+            let (t, rest_t) = std::mem::take(&mut tags).split_at_mut(end - first);
+            (start, sorted, tags) = (rest, rest_b, rest_t);
+            jobs.push((lo..hi, first, s, b, t));
+        }
+        jobs.into_par_iter()
+            .for_each(|(cells, first, cursor, boxes, tags)| {
+                for i in indices() {
+                    let k = keys[i] as usize;
+                    if !cells.contains(&k) {
+                        continue;
+                    }
+                    let Some(o) = object(i) else {
+                        continue;
+                    };
+                    let c = &mut cursor[k - cells.start];
+                    let at = *c as usize - first;
+                    boxes[at] = CellBox::new(&o, i as u32, pad);
+                    tags[at] = k as u32;
+                    *c += 1;
+                }
+            });
+        for k in (1..=ncells).rev() {
+            self.start[k] = self.start[k - 1];
+        }
+        self.start[0] = 0;
     }
 }
 
@@ -645,6 +767,10 @@ const REPAIR_WORK: f64 = 4.0;
 
 /// Objects per task of the pass that finds each object's level on rayon's threads.
 const LEVEL_CHUNK: usize = 8192;
+
+/// At most this many parts of a large level's counting sort run at once (each reads every
+/// member's key: [`Level::sort_in_parts`]).
+const FILL_PARTS: usize = 8;
 
 /// Objects per run of cells walked by one task when a level's pairs are found in parallel.
 const RUN_OBJECTS: usize = 8192;
@@ -1720,7 +1846,15 @@ impl<V: Vector> BroadPhase<V> {
             if self.levels[l].sorted.capacity() == 0 {
                 std::mem::swap(&mut self.levels[l].sorted, spare);
             }
-            let known = (keys.len() == n).then(|| (indices, &keys[..]));
+            let object = |i: usize| {
+                objs.prefetch(i + MEMBERS_AHEAD);
+                objs.object(i)
+            };
+            let known = (keys.len() == n).then(|| Known {
+                indices,
+                keys: &keys[..],
+                object,
+            });
             floor_cell = self.levels[l].build(members, known, topo, cell, limit, pad);
         }
         self.levels_used = used.len();
@@ -2105,6 +2239,62 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_large_level_sorted_in_parts_is_the_sequential_sort() {
+        let mut rng = Rng::new(5);
+        let topo = Topology {
+            min: DVec2::ZERO,
+            max: DVec2::splat(300.0),
+            border: Border::Bounce,
+        };
+        // Three levels, none merged (the widest cells the limit allows are narrower than the
+        // finest), so the second build takes every key from the first.
+        let objs = random_objs::<DVec2>(
+            &mut rng,
+            crate::world::PARALLEL_MIN + 7_000,
+            300.0,
+            0.5,
+            2.0,
+        );
+        // Moved by about a cell, some across a cell's edge.
+        let moved: Vec<BroadObject<DVec2>> = objs
+            .iter()
+            .map(|o| BroadObject {
+                center: o.center + DVec2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)),
+                ..*o
+            })
+            .collect();
+        type Sort = (Vec<u32>, Vec<u32>, Vec<u32>);
+        let sorts = |threads: usize| -> (Vec<Sort>, Vec<(u32, u32)>) {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut bp = BroadPhase::new(BroadPhaseMode::Grid);
+                let mut out = Vec::new();
+                bp.find_pairs(&objs, &topo, &mut out);
+                out.clear();
+                bp.find_pairs(&moved, &topo, &mut out);
+                let levels = bp
+                    .used
+                    .iter()
+                    .map(|&l| {
+                        let level = &bp.levels[l];
+                        let tags = level.sorted.iter().map(|b| b.tag).collect();
+                        (level.start.clone(), level.sorted_keys.clone(), tags)
+                    })
+                    .collect();
+                (levels, out)
+            })
+        };
+        let one = sorts(1);
+        assert_eq!(one.0.len(), 3, "levels");
+        assert_eq!(normalise(one.1.clone()), brute(&moved, &topo));
+        assert_eq!(sorts(2), one, "two threads");
+        assert_eq!(sorts(3), one, "three threads");
     }
 
     #[test]
