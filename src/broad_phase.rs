@@ -744,6 +744,10 @@ impl<V: Vector> Level<V> {
     }
 }
 
+/// A chunk of the kept list re-tested: how many pairs were tested, those that overlap, and what
+/// the caller's `then` gave for them.
+type Retested<T> = (u64, Vec<(u32, u32)>, Option<T>);
+
 /// After this many builds in a row of a Verlet list that served one step each, pairs are found
 /// with the plain grid (no skin, no list) for [`GRID_SPELL`] steps before a list is tried again.
 /// A pile jostled by the discrete step's separations leaves any skin every step: its list's
@@ -1322,6 +1326,27 @@ impl<V: Vector> BroadPhase<V> {
         out: &mut Vec<(u32, u32)>,
         escapes: Option<Escapes>,
     ) {
+        self.find_pairs_then(objs, topo, out, escapes, None::<&fn(&[(u32, u32)])>);
+    }
+
+    /// [`Self::find_pairs_in`], and `then` applied to each run of the pairs found where a kept
+    /// Verlet list is re-tested in parallel chunks, while the chunk's objects are still in cache:
+    /// its results, in the order of the pairs, or `None` when the pairs came another way. The
+    /// world gives its rules and narrow phase (at a million critters a second trip through
+    /// scattered critters otherwise).
+    pub(crate) fn find_pairs_then<O, T, F>(
+        &mut self,
+        objs: &O,
+        topo: &Topology<V>,
+        out: &mut Vec<(u32, u32)>,
+        escapes: Option<Escapes>,
+        then: Option<&F>,
+    ) -> Option<Vec<T>>
+    where
+        O: Objects<V> + ?Sized,
+        T: Send,
+        F: Fn(&[(u32, u32)]) -> T + Sync,
+    {
         out.clear();
         self.tests = 0;
         let n = objs.slots();
@@ -1333,10 +1358,12 @@ impl<V: Vector> BroadPhase<V> {
         if direct || n == 0 {
             self.levels_used = 0;
             self.all_pairs(objs, topo, out);
+            None
         } else if self.mode == BroadPhaseMode::Grid {
             self.grid(objs, topo, out, &mut Vec::new());
+            None
         } else {
-            self.listed_pairs(objs, topo, out, escapes);
+            self.listed_pairs(objs, topo, out, escapes, then)
         }
     }
 
@@ -1359,18 +1386,24 @@ impl<V: Vector> BroadPhase<V> {
     /// than half the skin from where it was then (and none came, went or changed size), every
     /// overlapping pair is among them, so a step only re-tests the kept pairs. When a few have,
     /// the list is mended for them (`repair_list`) rather than built anew.
-    fn listed_pairs<O: Objects<V> + ?Sized>(
+    fn listed_pairs<O, T, F>(
         &mut self,
         objs: &O,
         topo: &Topology<V>,
         out: &mut Vec<(u32, u32)>,
         escapes: Option<Escapes>,
-    ) {
+        then: Option<&F>,
+    ) -> Option<Vec<T>>
+    where
+        O: Objects<V> + ?Sized,
+        T: Send,
+        F: Fn(&[(u32, u32)]) -> T + Sync,
+    {
         if self.list.grid_left > 0 {
             self.list.grid_left -= 1;
             self.list.grid_steps += 1;
             self.plain_grid(objs, topo, out);
-            return;
+            return None;
         }
         let kept = self.list.valid && self.list.bounds.len() == objs.slots();
         // The escaped indices when the caller noted them all, else found by a pass of our own.
@@ -1393,7 +1426,7 @@ impl<V: Vector> BroadPhase<V> {
                 self.list.grid_left = GRID_SPELL - 1;
                 self.list.grid_steps += 1;
                 self.plain_grid(objs, topo, out);
-                return;
+                return None;
             }
             self.rebuild_list(objs, topo);
         } else if self.list.sort_wanted && !self.list.sorted {
@@ -1404,22 +1437,29 @@ impl<V: Vector> BroadPhase<V> {
         if objs.slots() >= crate::world::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread count.
             use rayon::prelude::*;
-            let parts: Vec<(u64, Vec<(u32, u32)>)> = self
+            let parts: Vec<Retested<T>> = self
                 .list
                 .pairs
                 .par_chunks(4096)
                 .map(|chunk| {
                     let mut part = Vec::new();
                     let tested = retest(objs, topo, chunk, &mut part);
-                    (tested, part)
+                    let after = then.map(|f| f(&part));
+                    (tested, part, after)
                 })
                 .collect();
-            for (tested, part) in parts {
+            let mut results = then.map(|_| Vec::with_capacity(parts.len()));
+            for (tested, part, after) in parts {
                 self.tests += tested;
                 out.extend(part);
+                if let (Some(results), Some(after)) = (&mut results, after) {
+                    results.push(after);
+                }
             }
+            results
         } else {
             self.tests += retest(objs, topo, &self.list.pairs, out);
+            None
         }
     }
 

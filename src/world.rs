@@ -252,6 +252,10 @@ pub struct World<V: Vector> {
     /// What the move stage did for the broad phase's input pass, which follows it at once (see
     /// [`World::stage_move`]); `None` when no move just ran.
     moved: Option<Moved>,
+    /// The rules and narrow phase done with the broad phase's re-test (see
+    /// [`World::stage_broad_phase`]): how many candidates may collide, and the time the pass took
+    /// on every thread together; `None` when they are still to do.
+    fused: Option<(usize, Duration)>,
     pub(crate) candidates: Vec<(u32, u32)>,
     /// (caller, arg, roles still to ask the hooks for)
     pub(crate) ruled: Vec<(u32, u32, bool)>,
@@ -292,6 +296,7 @@ impl<V: Vector> World<V> {
             stats: StepStats::default(),
             totals: StepStats::default(),
             moved: None,
+            fused: None,
             candidates: Vec::new(),
             ruled: Vec::new(),
             contacts: Vec::new(),
@@ -1000,7 +1005,7 @@ impl<V: Vector> World<V> {
             *slot += now - clock;
             clock = now;
         };
-        self.stage_broad_phase();
+        self.stage_broad_phase(true);
         if self.sleep.any() {
             // Two sleepers, or a sleeper and a wall, stay as they were.
             let still = self.sleep.still();
@@ -1008,16 +1013,28 @@ impl<V: Vector> World<V> {
             self.candidates
                 .retain(|&(a, b)| !(is_still(a) && is_still(b)));
         }
-        lap(&mut stats.broad_phase);
-        let ruled = match self.rules_and_narrow_phase_in_one_pass() {
-            Some(ruled) => ruled,
-            None => {
-                self.stage_rules()?;
-                lap(&mut stats.rules);
-                self.stage_narrow_phase()?;
-                self.ruled.len()
+        let mut broad = Duration::ZERO;
+        lap(&mut broad);
+        let ruled = match self.fused.take() {
+            Some((ruled, spent)) => {
+                // Done inside the broad phase's re-test on every thread: its share of the
+                // stage's time is estimated as the pass's time over the threads.
+                let share = (spent / rayon::current_num_threads().max(1) as u32).min(broad);
+                broad -= share;
+                stats.narrow_phase += share;
+                ruled
             }
+            None => match self.rules_and_narrow_phase_in_one_pass() {
+                Some(ruled) => ruled,
+                None => {
+                    self.stage_rules()?;
+                    lap(&mut stats.rules);
+                    self.stage_narrow_phase()?;
+                    self.ruled.len()
+                }
+            },
         };
+        stats.broad_phase += broad;
         self.sort_contacts();
         lap(&mut stats.narrow_phase);
         let collisions = match solve {
@@ -1171,7 +1188,7 @@ impl<V: Vector> World<V> {
         });
     }
 
-    fn stage_broad_phase(&mut self) {
+    fn stage_broad_phase(&mut self, fuse: bool) {
         // What the move stage did, if it ran just before over the same slots.
         let moved = self
             .moved
@@ -1225,8 +1242,33 @@ impl<V: Vector> World<V> {
             escapes.complete &= walls == m.walls;
             escapes
         });
-        self.broad
-            .find_pairs_in(&objs, &self.topo, &mut self.candidates, escapes);
+        // With no sleepers (whose pairs are dropped after the broad phase), the rules and the
+        // narrow phase run on each chunk of the kept list's re-test while its critters are in
+        // cache: the same lists, in the same order, as the pass over all the candidates after.
+        let (critters, rules, topo) = (&self.critters, &self.rules, &self.topo);
+        let narrow = |chunk: &[(u32, u32)]| {
+            let clock = Instant::now();
+            let (mut contacts, mut walls) = (Vec::new(), Vec::new());
+            let ruled = rules_and_narrow(critters, rules, topo, chunk, &mut contacts, &mut walls);
+            ruled.map(|ruled| (ruled, contacts, walls, clock.elapsed()))
+        };
+        let then = (fuse && !self.sleep.any()).then_some(&narrow);
+        let parts = self
+            .broad
+            .find_pairs_then(&objs, topo, &mut self.candidates, escapes, then);
+        self.fused = None;
+        if let Some(parts) = parts.and_then(|p| p.into_iter().collect::<Option<Vec<_>>>()) {
+            self.contacts.clear();
+            self.wall_pairs.clear();
+            let (mut ruled, mut spent) = (0, Duration::ZERO);
+            for (n, contacts, walls, time) in parts {
+                ruled += n;
+                spent += time;
+                self.contacts.extend(contacts);
+                self.wall_pairs.extend(walls);
+            }
+            self.fused = Some((ruled, spent));
+        }
     }
 
     fn stage_rules(&mut self) -> Result<(), Error> {
@@ -1287,51 +1329,10 @@ impl<V: Vector> World<V> {
     fn rules_and_narrow_phase_in_one_pass(&mut self) -> Option<usize> {
         use rayon::prelude::*;
         let (critters, rules, topo) = (&self.critters, &self.rules, &self.topo);
-        let slots = critters.slot_slice();
         let pass = |chunk: &[(u32, u32)],
                     contacts: &mut Vec<(u32, u32)>,
-                    walls: &mut Vec<(u32, u32, bool)>|
-         -> Option<usize> {
-            let mut ruled = 0;
-            // Every disk pair is written and the end moved on only for those that touch: in a
-            // gas most candidates do not, in no order a processor could predict.
-            let mut end = contacts.len();
-            contacts.resize(end + chunk.len(), (0, 0));
-            for (k, &(a, b)) in chunk.iter().enumerate() {
-                if let Some(&(i, j)) = chunk.get(k + CANDIDATES_AHEAD) {
-                    prefetch(slots.get(i as usize));
-                    prefetch(slots.get(j as usize));
-                }
-                let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
-                    continue;
-                };
-                let (first, second, ask) = match rules.cached(ca.class, cb.class)? {
-                    Some(rule) => match roles_order(rule, ca, cb) {
-                        Some((caller, arg)) => (caller, arg, false),
-                        None => continue,
-                    },
-                    None => (ca, cb, true),
-                };
-                ruled += 1;
-                let pair = (first.id.index, second.id.index);
-                if first.is_wall() || second.is_wall() {
-                    // Tested in the response, once the disk pairs have moved.
-                    walls.push((pair.0, pair.1, ask));
-                } else {
-                    let touching = crate::contact::touching_ball_ball(
-                        topo.delta(first.pos, second.pos),
-                        first.radius,
-                        second.radius,
-                    );
-                    if ask & touching {
-                        return None;
-                    }
-                    contacts[end] = pair;
-                    end += usize::from(touching);
-                }
-            }
-            contacts.truncate(end);
-            Some(ruled)
+                    walls: &mut Vec<(u32, u32, bool)>| {
+            rules_and_narrow(critters, rules, topo, chunk, contacts, walls)
         };
         self.contacts.clear();
         self.wall_pairs.clear();
@@ -1565,6 +1566,62 @@ pub(crate) fn at_step(e: Error, step: u64) -> Error {
         }
         other => other,
     }
+}
+
+/// The rules and the narrow phase of a run of candidates: the pairs that may collide, in the
+/// roles their rule gives, kept in `contacts` if they are two touching disks and in `walls` if
+/// one is a wall (tested in the response); returns how many may collide. `None` when a pair's
+/// rule is not in the class table, or a touching pair's roles are to be asked of the hooks (the
+/// rules would run a script): the caller then runs the stages one after the other.
+fn rules_and_narrow<V: Vector>(
+    critters: &CritterSet<V>,
+    rules: &RuleCache,
+    topo: &Topology<V>,
+    chunk: &[(u32, u32)],
+    contacts: &mut Vec<(u32, u32)>,
+    walls: &mut Vec<(u32, u32, bool)>,
+) -> Option<usize> {
+    let slots = critters.slot_slice();
+    let mut ruled = 0;
+    // Every disk pair is written and the end moved on only for those that touch: in a gas most
+    // candidates do not, in no order a processor could predict.
+    let mut end = contacts.len();
+    contacts.resize(end + chunk.len(), (0, 0));
+    for (k, &(a, b)) in chunk.iter().enumerate() {
+        if let Some(&(i, j)) = chunk.get(k + CANDIDATES_AHEAD) {
+            prefetch(slots.get(i as usize));
+            prefetch(slots.get(j as usize));
+        }
+        let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
+            continue;
+        };
+        let (first, second, ask) = match rules.cached(ca.class, cb.class)? {
+            Some(rule) => match roles_order(rule, ca, cb) {
+                Some((caller, arg)) => (caller, arg, false),
+                None => continue,
+            },
+            None => (ca, cb, true),
+        };
+        ruled += 1;
+        let pair = (first.id.index, second.id.index);
+        if first.is_wall() || second.is_wall() {
+            // Tested in the response, once the disk pairs have moved.
+            walls.push((pair.0, pair.1, ask));
+        } else {
+            let touching = crate::contact::touching_ball_ball(
+                topo.delta(first.pos, second.pos),
+                first.radius,
+                second.radius,
+            );
+            if ask & touching {
+                return None;
+            }
+            contacts[end] = pair;
+            end += usize::from(touching);
+        }
+    }
+    contacts.truncate(end);
+    Some(ruled)
 }
 
 /// (caller, arg) for a pair under `rule`, or `None` when they don't collide.
@@ -1845,8 +1902,9 @@ mod tests {
     use glam::DVec2;
 
     /// The rules and narrow stages in one pass give the lists of the two stages one after the
-    /// other, on one thread and in parallel chunks, on a gas with walls that has settled into
-    /// many candidate pairs.
+    /// other, on one thread and in parallel chunks, and so do they when done with the broad
+    /// phase's re-test of the kept list, on a gas with walls that has settled into many
+    /// candidate pairs.
     #[test]
     fn rules_and_narrow_phase_in_one_pass_match_them_one_after_the_other() {
         let check = || {
@@ -1859,7 +1917,7 @@ mod tests {
             let mut checked = 0;
             for _ in 0..30 {
                 w.step().unwrap();
-                w.stage_broad_phase();
+                w.stage_broad_phase(false);
                 if w.candidates.len() < PARALLEL_PAIRS {
                     continue;
                 }
@@ -1876,6 +1934,14 @@ mod tests {
                     w.wall_pairs.clone(),
                 );
                 assert_eq!(fused, in_order);
+                // And with the broad phase's re-test, chunk by chunk.
+                w.contacts.clear();
+                w.wall_pairs.clear();
+                w.stage_broad_phase(true);
+                let (ruled, _) = w.fused.take().expect("done with the re-test");
+                w.sort_contacts();
+                let with_retest = (ruled, w.contacts.clone(), w.wall_pairs.clone());
+                assert_eq!(with_retest, in_order);
                 checked += 1;
             }
             checked
@@ -1946,7 +2012,7 @@ mod tests {
         let changes = |w: &World<DVec2>| w.broad_phase_rebuilds() + w.broad_phase_repairs();
         let rebuilds = changes(w);
         w.stage_move(w.dt);
-        w.stage_broad_phase();
+        w.stage_broad_phase(false);
         assert_fresh_pairs(w, what);
         changes(w) > rebuilds
     }
@@ -2010,7 +2076,7 @@ mod tests {
                     assert_eq!(moved.escapes.slots, full, "n {n}, step {step}");
                     noted += full.len();
                 }
-                w.stage_broad_phase();
+                w.stage_broad_phase(false);
                 assert_fresh_pairs(&w, &format!("n {n}, step {step}"));
                 repairs += w.broad_phase_repairs() - before;
             }
