@@ -1187,7 +1187,7 @@ fn merge_tail(pairs: &mut Vec<(u32, u32)>, start: usize) {
 /// world, in its move) found: the indices [`BroadPhase::list_holds`] said no for. A repair then
 /// mends those without another pass over every object (at a million critters, a trip through
 /// 128 MB).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug)]
 pub(crate) struct Escapes {
     /// The indices whose object left its bound, ascending.
     pub(crate) slots: Vec<u32>,
