@@ -607,7 +607,29 @@ impl<V: Vector> Level<V> {
                 }
             }
         }
-        // Exclusive prefix sum, carried in a register (a loop through memory stalls on each add).
+        self.ready_to_fill(m);
+        // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
+        // `ends_to_starts` turns ends back into starts.
+        // Each key is taken from `known` or found again from the centre (a few operations on
+        // what is read anyway) rather than kept from the count: 4 bytes per member less.
+        for (i, o) in members() {
+            let k = match &known {
+                Some(known) => known.keys[i as usize] as usize,
+                None => self.key(self.coords(topo, o.center)),
+            };
+            let at = self.start[k] as usize;
+            self.sorted[at] = CellBox::new(&o, i, pad);
+            self.sorted_keys[at] = k as u32;
+            self.start[k] += 1;
+        }
+        self.ends_to_starts();
+        cell
+    }
+
+    /// Turns the cell counts in `start` into each cell's first place (an exclusive prefix sum,
+    /// carried in a register: a loop through memory stalls on each add), and sizes the sorted
+    /// copies for `m` members.
+    fn ready_to_fill(&mut self, m: usize) {
         let mut acc = 0u32;
         for s in self.start.iter_mut() {
             let count = *s;
@@ -622,25 +644,16 @@ impl<V: Vector> Level<V> {
         }
         self.sorted_keys.clear();
         self.sorted_keys.resize(m, 0);
-        // `start[k]` is used as the fill cursor of cell k, which leaves it at the cell's end;
-        // the shift below turns ends back into starts.
-        // Each key is taken from `known` or found again from the centre (a few operations on
-        // what is read anyway) rather than kept from the count: 4 bytes per member less.
-        for (i, o) in members() {
-            let k = match &known {
-                Some(known) => known.keys[i as usize] as usize,
-                None => self.key(self.coords(topo, o.center)),
-            };
-            let at = self.start[k] as usize;
-            self.sorted[at] = CellBox::new(&o, i, pad);
-            self.sorted_keys[at] = k as u32;
-            self.start[k] += 1;
-        }
+    }
+
+    /// After a fill that used `start[k]` as cell k's cursor, which left it at the cell's end:
+    /// each cell's start again.
+    fn ends_to_starts(&mut self) {
+        let ncells = self.start.len() - 1;
         for k in (1..=ncells).rev() {
             self.start[k] = self.start[k - 1];
         }
         self.start[0] = 0;
-        cell
     }
 
     /// [`Level::build`]'s counting sort with every member's key known, in `parts` ranges of
@@ -679,19 +692,7 @@ impl<V: Vector> Level<V> {
                 m
             })
             .sum();
-        let mut acc = 0u32;
-        for s in self.start.iter_mut() {
-            let count = *s;
-            *s = acc;
-            acc += count;
-        }
-        self.sorted.clear();
-        self.sorted.resize(m, CellBox::default());
-        if self.sorted_keys.capacity() == 0 {
-            self.sorted_keys = std::mem::take(&mut self.members);
-        }
-        self.sorted_keys.clear();
-        self.sorted_keys.resize(m, 0);
+        self.ready_to_fill(m);
         // Cells cut where the members before reach each part's share.
         let mut cuts = vec![0usize];
         for p in 1..parts {
@@ -737,10 +738,7 @@ impl<V: Vector> Level<V> {
                     *c += 1;
                 }
             });
-        for k in (1..=ncells).rev() {
-            self.start[k] = self.start[k - 1];
-        }
-        self.start[0] = 0;
+        self.ends_to_starts();
     }
 }
 
