@@ -232,6 +232,18 @@ impl StepStats {
     }
 }
 
+/// Whether the rules and narrow phase were done with the broad phase's re-test.
+#[derive(Clone, Copy, Debug)]
+enum Fused {
+    /// Not tried: the pairs came another way, or sleepers are about.
+    NotTried,
+    /// A pair's rule is not in the class table, or its roles are to be asked of the hooks: the
+    /// stages run one after the other.
+    Refused,
+    /// Done: how many candidates may collide, and the pass's time on every thread together.
+    Done(usize, Duration),
+}
+
 /// A world of critters in 2D (`World<DVec2>`) or 3D (`World<DVec3>`).
 pub struct World<V: Vector> {
     pub(crate) topo: Topology<V>,
@@ -254,8 +266,8 @@ pub struct World<V: Vector> {
     moved: Option<Moved>,
     /// The rules and narrow phase done with the broad phase's re-test (see
     /// [`World::stage_broad_phase`]): how many candidates may collide, and the time the pass took
-    /// on every thread together; `None` when they are still to do.
-    fused: Option<(usize, Duration)>,
+    /// on every thread together; or that they were refused (a pair's rule is to be asked).
+    fused: Fused,
     pub(crate) candidates: Vec<(u32, u32)>,
     /// (caller, arg, roles still to ask the hooks for)
     pub(crate) ruled: Vec<(u32, u32, bool)>,
@@ -296,7 +308,7 @@ impl<V: Vector> World<V> {
             stats: StepStats::default(),
             totals: StepStats::default(),
             moved: None,
-            fused: None,
+            fused: Fused::NotTried,
             candidates: Vec::new(),
             ruled: Vec::new(),
             contacts: Vec::new(),
@@ -1015,24 +1027,27 @@ impl<V: Vector> World<V> {
         }
         let mut broad = Duration::ZERO;
         lap(&mut broad);
-        let ruled = match self.fused.take() {
-            Some((ruled, spent)) => {
+        let ruled = match std::mem::replace(&mut self.fused, Fused::NotTried) {
+            Fused::Done(ruled, spent) => {
                 // Done inside the broad phase's re-test on every thread: its share of the
                 // stage's time is estimated as the pass's time over the threads.
                 let share = (spent / rayon::current_num_threads().max(1) as u32).min(broad);
                 broad -= share;
                 stats.narrow_phase += share;
-                ruled
+                Some(ruled)
             }
-            None => match self.rules_and_narrow_phase_in_one_pass() {
-                Some(ruled) => ruled,
-                None => {
-                    self.stage_rules()?;
-                    lap(&mut stats.rules);
-                    self.stage_narrow_phase()?;
-                    self.ruled.len()
-                }
-            },
+            // The pass over all the candidates would refuse them too.
+            Fused::Refused => None,
+            Fused::NotTried => self.rules_and_narrow_phase_in_one_pass(),
+        };
+        let ruled = match ruled {
+            Some(ruled) => ruled,
+            None => {
+                self.stage_rules()?;
+                lap(&mut stats.rules);
+                self.stage_narrow_phase()?;
+                self.ruled.len()
+            }
         };
         stats.broad_phase += broad;
         self.sort_contacts();
@@ -1256,19 +1271,22 @@ impl<V: Vector> World<V> {
         let parts = self
             .broad
             .find_pairs_then(&objs, topo, &mut self.candidates, escapes, then);
-        self.fused = None;
-        if let Some(parts) = parts.and_then(|p| p.into_iter().collect::<Option<Vec<_>>>()) {
-            self.contacts.clear();
-            self.wall_pairs.clear();
-            let (mut ruled, mut spent) = (0, Duration::ZERO);
-            for (n, contacts, walls, time) in parts {
-                ruled += n;
-                spent += time;
-                self.contacts.extend(contacts);
-                self.wall_pairs.extend(walls);
+        self.fused = match parts.map(|p| p.into_iter().collect::<Option<Vec<_>>>()) {
+            None => Fused::NotTried,
+            Some(None) => Fused::Refused,
+            Some(Some(parts)) => {
+                self.contacts.clear();
+                self.wall_pairs.clear();
+                let (mut ruled, mut spent) = (0, Duration::ZERO);
+                for (n, contacts, walls, time) in parts {
+                    ruled += n;
+                    spent += time;
+                    self.contacts.extend(contacts);
+                    self.wall_pairs.extend(walls);
+                }
+                Fused::Done(ruled, spent)
             }
-            self.fused = Some((ruled, spent));
-        }
+        };
     }
 
     fn stage_rules(&mut self) -> Result<(), Error> {
@@ -1938,7 +1956,9 @@ mod tests {
                 w.contacts.clear();
                 w.wall_pairs.clear();
                 w.stage_broad_phase(true);
-                let (ruled, _) = w.fused.take().expect("done with the re-test");
+                let Fused::Done(ruled, _) = w.fused else {
+                    panic!("not done with the re-test");
+                };
                 w.sort_contacts();
                 let with_retest = (ruled, w.contacts.clone(), w.wall_pairs.clone());
                 assert_eq!(with_retest, in_order);

@@ -7,8 +7,8 @@ mod common;
 use common::*;
 use critterbox::glam::DVec2;
 use critterbox::{
-    CollideRule, CritterId, CritterSpec, KindDefaults, KindHooks, Rng, WallBox, World, CP_BULLET,
-    CP_CRITTER, CP_PLAYER,
+    BroadPhaseMode, CollideRule, CritterId, CritterSpec, KindDefaults, KindHooks, Rng, WallBox,
+    World, WorldConfig, CP_BULLET, CP_CRITTER, CP_PLAYER,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::rc::Rc;
@@ -371,6 +371,44 @@ fn kind_whose_rule_depends_on_state_is_asked_for_every_pair_every_step() {
         "both sides asked for every candidate pair"
     );
     assert_eq!(world.rule_cache().computed(), 0, "nothing cached");
+}
+
+/// A crowd large enough for the rules and narrow phase to run with the broad phase's re-test of
+/// its Verlet list, with a kind whose rule depends on state among plain balls: whenever two of
+/// them touch, that is refused and the stages run one after the other. The same hooks are asked,
+/// the same `collide` calls made in the same order, and the same states reached as with the plain
+/// grid, which keeps no list.
+#[test]
+fn a_large_crowd_whose_rule_depends_on_state_meets_as_with_the_plain_grid() {
+    let run = |mode: BroadPhaseMode| {
+        let log = call_log();
+        let moody = Rc::new(Recorder {
+            state_dependent: true,
+            ..Recorder::new(&log)
+        });
+        let mut config = WorldConfig::new(DVec2::ZERO, DVec2::splat(300.0));
+        config.broad_phase = mode;
+        let mut world = World::new(config).unwrap();
+        register(&mut world, "moody", kind(CP_CRITTER), moody.clone());
+        let mut rng = Rng::new(8);
+        for i in 0..22_000 {
+            let name = if i % 4 == 0 { "moody" } else { "ball" };
+            let p = DVec2::new(rng.uniform(1.0, 299.0), rng.uniform(1.0, 299.0));
+            let v = DVec2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+            world.spawn(CritterSpec::new(name, p).vel(v)).unwrap();
+        }
+        let hashes: Vec<u64> = (0..10)
+            .map(|_| {
+                world.step().unwrap();
+                world.state_hash()
+            })
+            .collect();
+        let calls = log.borrow().clone();
+        (hashes, moody.asked.get(), calls)
+    };
+    let listed = run(BroadPhaseMode::Auto);
+    assert!(listed.1 > 100, "test setup: moody critters touched");
+    assert_eq!(listed, run(BroadPhaseMode::Grid));
 }
 
 // ----- the classic kinds ------------------------------------------------------------------------
