@@ -1640,6 +1640,11 @@ impl<V: Vector> BroadPhase<V> {
         self.list.crowded = crowded;
     }
 
+    /// Drops the Verlet list: the next search builds a new one (the objects' indices changed).
+    pub(crate) fn forget_list(&mut self) {
+        self.list.valid = false;
+    }
+
     /// Pairs in the Verlet list (0 without one).
     pub(crate) fn listed(&self) -> usize {
         if self.list.valid {

@@ -174,12 +174,12 @@ impl<V: Vector> Access<'_, V> {
     /// The engine's physical response between `caller` and `arg` (Pop's `cCritter::collide`),
     /// recorded as a collision event. `None` when they don't touch (or either is gone).
     pub fn collide_default_pair(&mut self, caller: CritterId, arg: CritterId) -> Option<Hit<V>> {
-        if caller == arg || self.critters.get(caller).is_none() || self.critters.get(arg).is_none()
-        {
+        if caller == arg {
             return None;
         }
+        let (a, b) = (self.critters.slot_of(caller)?, self.critters.slot_of(arg)?);
         let topo = self.topo;
-        let (me, other) = self.critters.pair_mut_moving(caller.index, arg.index);
+        let (me, other) = self.critters.pair_mut_moving(a, b);
         let hit = response::collide_default(topo, me, other)?;
         self.events.collisions.push(CollisionEvent {
             caller,

@@ -26,6 +26,7 @@
 //! compare them on 2D and 3D worlds with every bit of every field flipped in turn.
 
 use crate::critter::{Critter, PropValue};
+use crate::critter_set::InIdOrder;
 use crate::hash::StateHasher;
 use crate::vector::Vector;
 use std::sync::{Mutex, PoisonError};
@@ -177,13 +178,9 @@ impl<V: Vector> Sums<V> {
 
 /// The kinetic energy and momentum of the free critters of `slots`, summed as every pass sums
 /// them: the critter in slot `i` into sum `i % SETS`, the sums added in order.
-pub fn totals<V: Vector>(slots: &[Option<Critter<V>>]) -> (f64, V) {
+pub fn totals<V: Vector>(critters: InIdOrder<'_, V>) -> (f64, V) {
     let mut sums = Sums::new();
-    for (i, c) in slots.iter().enumerate() {
-        if let Some(c) = c {
-            sums.add(i % SETS, c);
-        }
-    }
+    for_each_in_sets(critters, |s, c| sums.add(s, c));
     sums.total()
 }
 
@@ -202,10 +199,18 @@ pub struct Pass<V> {
 /// [`SETS`], with `s` a constant in the unrolled main loop (so sets indexed by it stay in
 /// registers).
 #[inline(always)]
-fn for_each_in_sets<V: Vector>(
-    slots: &[Option<Critter<V>>],
-    mut f: impl FnMut(usize, &Critter<V>),
-) {
+fn for_each_in_sets<V: Vector>(critters: InIdOrder<'_, V>, mut f: impl FnMut(usize, &Critter<V>)) {
+    if !critters.place.is_empty() {
+        // Stored in other slots than their ids' (see [`crate::critter_set::CritterSet::arrange`]):
+        // the same order, set by set, through the table.
+        for i in 0..critters.len() {
+            if let Some(c) = critters.at(i) {
+                f(i % SETS, c);
+            }
+        }
+        return;
+    }
+    let slots = critters.slots;
     let mut chunks = slots.chunks_exact(SETS);
     for chunk in &mut chunks {
         for (s, slot) in chunk.iter().enumerate() {
@@ -223,7 +228,7 @@ fn for_each_in_sets<V: Vector>(
 
 /// One pass over every critter of `slots` (empty slots skipped): the lanes, the totals, and
 /// non-empty properties hashed into `props`. Uses AVX-512 when the CPU has it.
-pub fn pass<V: Vector>(slots: &[Option<Critter<V>>], props: &mut StateHasher) -> Pass<V> {
+pub fn pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass<V> {
     #[cfg(target_arch = "x86_64")]
     if has_avx512() {
         // SAFETY: the CPU has the features the function is compiled for.
@@ -240,7 +245,7 @@ fn has_avx512() -> bool {
 }
 
 /// [`pass`] one lane at a time, on any CPU.
-pub fn portable_pass<V: Vector>(slots: &[Option<Critter<V>>], props: &mut StateHasher) -> Pass<V> {
+pub fn portable_pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass<V> {
     let mut moving = [0; SETS].map(start_moving);
     let mut statics = start_static();
     let mut sums = Sums::new();
@@ -296,7 +301,7 @@ pub struct MovingPass<V> {
 }
 
 /// [`pass`] over each critter's first [`MOVING`] words only (no properties).
-pub fn moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+pub fn moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
     #[cfg(target_arch = "x86_64")]
     if has_avx512() {
         // SAFETY: the CPU has the features the function is compiled for.
@@ -306,7 +311,7 @@ pub fn moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
 }
 
 /// [`moving_pass`] one lane at a time, on any CPU.
-pub fn portable_moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+pub fn portable_moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
     let mut lanes = [0; SETS].map(start_moving);
     let mut sums = Sums::new();
     for_each_in_sets(slots, |s, c| {
@@ -381,7 +386,7 @@ pub struct Hashed<V> {
 
 /// The critters of `slots` hashed: the same bits as a whole [`pass`] (and the properties' hash),
 /// but reading only each critter's first [`MOVING`] words when `statics` still holds the rest.
-pub fn hash_critters<V: Vector>(slots: &[Option<Critter<V>>], statics: &Statics) -> Hashed<V> {
+pub fn hash_critters<V: Vector>(slots: InIdOrder<'_, V>, statics: &Statics) -> Hashed<V> {
     let mut kept = statics.0.lock().unwrap_or_else(PoisonError::into_inner);
     if let Some(k) = *kept {
         let m = moving_pass(slots);
@@ -500,10 +505,7 @@ mod avx512 {
     /// # Safety
     /// The CPU must have AVX-512F, DQ and BW.
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
-    pub unsafe fn pass<V: Vector>(
-        slots: &[Option<Critter<V>>],
-        props: &mut StateHasher,
-    ) -> Pass<V> {
+    pub unsafe fn pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass<V> {
         let Some([mask_a, mask_b]) = byte_masks::<V>() else {
             return portable_pass(slots, props);
         };
@@ -534,7 +536,7 @@ mod avx512 {
     /// # Safety
     /// The CPU must have AVX-512F, DQ and BW.
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
-    pub unsafe fn moving_pass<V: Vector>(slots: &[Option<Critter<V>>]) -> MovingPass<V> {
+    pub unsafe fn moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
         let Some([mask_a, _]) = byte_masks::<V>() else {
             return portable_moving_pass(slots);
         };
@@ -619,7 +621,7 @@ mod tests {
 
     /// Both passes over `w`'s critters: the lanes and the totals.
     fn both<V: Vector>(w: &World<V>) -> (Pass<V>, Pass<V>) {
-        let slots = w.critters().slot_slice();
+        let slots = w.critters().in_id_order();
         let (mut p1, mut p2) = (StateHasher::default(), StateHasher::default());
         let fast = pass(slots, &mut p1);
         let portable = portable_pass(slots, &mut p2);

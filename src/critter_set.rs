@@ -1,8 +1,15 @@
 //! Storage for critters: slots addressed by generational ids, O(1) insert and remove.
 //!
-//! A removed critter's slot goes on a free list and is reused with the next generation, so ids
-//! stay stable and a dead critter's id never names a new one. Iteration is in slot order:
+//! A removed critter's id index goes on a free list and is reused with the next generation, so
+//! ids stay stable and a dead critter's id never names a new one. Iteration is in id order:
 //! deterministic, whatever was added or removed.
+//!
+//! The critters are stored by *slot*. Until [`CritterSet::arrange`] is called a critter's slot is
+//! its id's index; `arrange` moves them to other slots (the world lays a large gas out along its
+//! grid, so that critters near each other in space are near each other in memory) and a table
+//! then maps each id to its slot. The engine's passes go in slot order; everything seen from
+//! outside (iteration, the state hash, the totals) goes in id order, so where the critters are
+//! stored never shows.
 
 use crate::critter::{Critter, CritterId};
 use crate::critter_hash::Statics;
@@ -15,11 +22,64 @@ use crate::vector::Vector;
 /// velocities and rule classes only, do not (see [`Statics`]).
 #[derive(Clone, Debug)]
 pub struct CritterSet<V: Vector> {
+    /// The critters by slot.
     slots: Vec<Option<Critter<V>>>,
+    /// By id index: the generation of its current or next critter.
     generations: Vec<u32>,
+    /// Free id indices (the last is reused first).
     free: Vec<u32>,
+    /// By id index: the slot of its critter ([`NO_SLOT`] if none). Empty while every critter's
+    /// slot is its id's index.
+    place: Vec<u32>,
     live: usize,
     statics: Statics,
+}
+
+/// In [`CritterSet`]'s table of slots: an id index with no critter.
+const NO_SLOT: u32 = u32::MAX;
+
+/// The critters of a set seen in id order: the slots, and by id index the slot of its critter
+/// (empty when every critter's slot is its id's index). The state hash and totals go through
+/// this, so they do not depend on where the critters are stored.
+#[derive(Clone, Copy, Debug)]
+pub struct InIdOrder<'a, V: Vector> {
+    /// The critters by slot.
+    pub slots: &'a [Option<Critter<V>>],
+    /// By id index, the slot ([`u32::MAX`] for none); empty for slot = id index.
+    pub place: &'a [u32],
+}
+
+impl<'a, V: Vector> From<&'a [Option<Critter<V>>]> for InIdOrder<'a, V> {
+    fn from(slots: &'a [Option<Critter<V>>]) -> Self {
+        InIdOrder { slots, place: &[] }
+    }
+}
+
+impl<'a, V: Vector> InIdOrder<'a, V> {
+    /// How many id indices there are.
+    pub fn len(&self) -> usize {
+        if self.place.is_empty() {
+            self.slots.len()
+        } else {
+            self.place.len()
+        }
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The critter of id index `i`.
+    #[inline]
+    pub fn at(&self, i: usize) -> Option<&'a Critter<V>> {
+        let slot = if self.place.is_empty() {
+            i
+        } else {
+            self.place[i] as usize
+        };
+        self.slots.get(slot).and_then(Option::as_ref)
+    }
 }
 
 impl<V: Vector> Default for CritterSet<V> {
@@ -28,6 +88,7 @@ impl<V: Vector> Default for CritterSet<V> {
             slots: Vec::new(),
             generations: Vec::new(),
             free: Vec::new(),
+            place: Vec::new(),
             live: 0,
             statics: Statics::default(),
         }
@@ -41,16 +102,27 @@ impl<V: Vector> CritterSet<V> {
         let index = match self.free.pop() {
             Some(i) => i,
             None => {
-                self.slots.push(None);
                 self.generations.push(0);
-                (self.slots.len() - 1) as u32
+                if self.place.is_empty() {
+                    self.slots.push(None);
+                } else {
+                    self.place.push(NO_SLOT);
+                }
+                (self.generations.len() - 1) as u32
             }
         };
         let id = CritterId {
             index,
             generation: self.generations[index as usize],
         };
-        self.slots[index as usize] = Some(make(id));
+        let critter = Some(make(id));
+        if self.place.is_empty() {
+            self.slots[index as usize] = critter;
+        } else {
+            // Arranged: a new critter goes in a new slot at the end, until the next arrangement.
+            self.place[index as usize] = self.slots.len() as u32;
+            self.slots.push(critter);
+        }
         self.live += 1;
         id
     }
@@ -61,6 +133,123 @@ impl<V: Vector> CritterSet<V> {
     pub fn reserve(&mut self, additional: usize) {
         self.slots.reserve_exact(additional);
         self.generations.reserve_exact(additional);
+        if !self.place.is_empty() {
+            self.place.reserve_exact(additional);
+        }
+    }
+
+    /// The slot of critter `id`, if it is there.
+    #[inline]
+    pub fn slot_of(&self, id: CritterId) -> Option<u32> {
+        let i = id.index as usize;
+        let slot = if self.place.is_empty() {
+            id.index
+        } else {
+            *self.place.get(i)?
+        };
+        match self.slots.get(slot as usize) {
+            Some(Some(c)) if c.id == id => Some(slot),
+            _ => None,
+        }
+    }
+
+    /// How many id indices there are (live or free): id indices are below this.
+    pub(crate) fn index_count(&self) -> usize {
+        self.generations.len()
+    }
+
+    /// The slot of the critter with id index `index`, if there is one.
+    #[inline]
+    pub(crate) fn slot_of_index(&self, index: u32) -> Option<u32> {
+        let slot = if self.place.is_empty() {
+            index
+        } else {
+            *self.place.get(index as usize)?
+        };
+        self.slots
+            .get(slot as usize)
+            .is_some_and(Option::is_some)
+            .then_some(slot)
+    }
+
+    /// True once [`CritterSet::arrange`] has put critters in slots other than their ids'.
+    pub fn is_arranged(&self) -> bool {
+        !self.place.is_empty()
+    }
+
+    /// The critters seen in id order (see [`InIdOrder`]).
+    pub fn in_id_order(&self) -> InIdOrder<'_, V> {
+        InIdOrder {
+            slots: &self.slots,
+            place: &self.place,
+        }
+    }
+
+    /// Moves the critters to new slots in the order of `keys` (one per slot, below `u32::MAX`
+    /// for an occupied one and `u32::MAX` for an empty one; ties in slot order), the empty
+    /// slots dropped. Ids do not change. The moves follow the permutation's
+    /// cycles in place, so no second copy of the critters is made; the only other memory is the
+    /// table from ids to slots, which the moves use first for the order.
+    ///
+    /// # Panics
+    /// If `keys` is not one per slot, or there are 2^31 slots or more.
+    pub(crate) fn arrange(&mut self, keys: &[u32]) {
+        use rayon::prelude::*;
+        const DONE: u32 = 1 << 31;
+        let n = self.slots.len();
+        assert!(keys.len() == n && n < DONE as usize, "a key per slot");
+        // Slot k takes the critter of slot order[k]; the empty slots go last.
+        let mut order = std::mem::take(&mut self.place);
+        order.clear();
+        order.extend(0..n as u32);
+        order.par_sort_unstable_by_key(|&s| (keys[s as usize], s));
+        // Follow each cycle, marking what is done.
+        for start in 0..n {
+            if order[start] & DONE != 0 {
+                continue;
+            }
+            let mut k = start;
+            loop {
+                let from = order[k] as usize;
+                order[k] |= DONE;
+                if from == start {
+                    break;
+                }
+                self.slots.swap(k, from);
+                k = from;
+            }
+        }
+        self.slots.truncate(self.live);
+        debug_assert!(self.slots.iter().all(Option::is_some));
+        order.clear();
+        order.resize(self.generations.len(), NO_SLOT);
+        for (slot, c) in self.slots.iter().enumerate() {
+            if let Some(c) = c {
+                order[c.id.index as usize] = slot as u32;
+            }
+        }
+        self.place = order;
+    }
+
+    /// Puts every critter back in the slot its id's index names (undoes [`CritterSet::arrange`]).
+    pub(crate) fn unarrange(&mut self) {
+        if self.place.is_empty() {
+            return;
+        }
+        let n = self.generations.len();
+        self.slots.resize_with(self.slots.len().max(n), || None);
+        // Slot k takes the critter of id index k: follow each cycle by the critters' ids.
+        for start in 0..self.slots.len() {
+            while let Some(c) = &self.slots[start] {
+                let home = c.id.index as usize;
+                if home == start {
+                    break;
+                }
+                self.slots.swap(start, home);
+            }
+        }
+        self.slots.truncate(n);
+        self.place = Vec::new();
     }
 
     /// Removes critter `id`, if it is there. O(1).
@@ -69,8 +258,19 @@ impl<V: Vector> CritterSet<V> {
         if self.generations.get(i) != Some(&id.generation) {
             return None;
         }
+        let slot = if self.place.is_empty() {
+            i
+        } else {
+            self.place[i] as usize
+        };
+        if !matches!(self.slots.get(slot), Some(Some(c)) if c.id == id) {
+            return None;
+        }
         self.statics.forget();
-        let critter = self.slots[i].take()?;
+        let critter = self.slots[slot].take()?;
+        if !self.place.is_empty() {
+            self.place[i] = NO_SLOT;
+        }
         self.live -= 1;
         // A slot whose generation would wrap is retired rather than reused.
         if let Some(next) = self.generations[i].checked_add(1) {
@@ -83,20 +283,14 @@ impl<V: Vector> CritterSet<V> {
     /// The critter with id `id`, if it is still there.
     #[inline]
     pub fn get(&self, id: CritterId) -> Option<&Critter<V>> {
-        match self.slots.get(id.index as usize) {
-            Some(Some(c)) if c.id == id => Some(c),
-            _ => None,
-        }
+        self.slot(self.slot_of(id)?)
     }
 
     /// The critter with id `id`, mutably.
     #[inline]
     pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
-        self.statics.forget();
-        match self.slots.get_mut(id.index as usize) {
-            Some(Some(c)) if c.id == id => Some(c),
-            _ => None,
-        }
+        let slot = self.slot_of(id)?;
+        self.slot_mut(slot)
     }
 
     /// The critter in slot `index`.
@@ -162,12 +356,18 @@ impl<V: Vector> CritterSet<V> {
         self.slots.len()
     }
 
-    /// The critters, in slot order.
+    /// The critters, in id order.
     pub fn iter(&self) -> impl Iterator<Item = &Critter<V>> {
+        let view = self.in_id_order();
+        (0..view.len()).filter_map(move |i| view.at(i))
+    }
+
+    /// The critters, in slot order (the engine's passes, where order does not count).
+    pub(crate) fn iter_stored(&self) -> impl Iterator<Item = &Critter<V>> {
         self.slots.iter().filter_map(Option::as_ref)
     }
 
-    /// The critters, in slot order, in parallel (each is visited by one thread).
+    /// The critters, in parallel (each is visited by one thread).
     pub fn par_iter_mut(&mut self) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
         self.statics.forget();
         use rayon::prelude::*;
@@ -218,6 +418,7 @@ impl<V: Vector> CritterSet<V> {
             slots: (0..slots_needed).map(|_| None).collect(),
             generations: vec![u32::MAX; slots_needed],
             free: Vec::with_capacity(free.len()),
+            place: Vec::new(),
             live: 0,
             statics: Statics::default(),
         };
@@ -241,14 +442,18 @@ impl<V: Vector> CritterSet<V> {
         Some(set)
     }
 
-    /// The critters, in slot order, mutably.
+    /// The critters, in id order, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.statics.forget();
+        if !self.place.is_empty() {
+            // Slot order is id order again (a rare call: scripts and tests).
+            self.unarrange();
+        }
         self.iter_mut_moving()
     }
 
-    /// [`CritterSet::iter_mut`] for the engine's writes of position, velocity and rule class
-    /// only.
+    /// The critters in slot order, mutably, for the engine's writes of position, velocity and
+    /// rule class only.
     pub(crate) fn iter_mut_moving(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.slots.iter_mut().filter_map(Option::as_mut)
     }

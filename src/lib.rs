@@ -65,4 +65,4 @@ pub use method::Method;
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;
-pub use world::{StepStats, World, WorldConfig};
+pub use world::{Locality, StepStats, World, WorldConfig};

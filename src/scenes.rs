@@ -53,6 +53,14 @@ impl AnyWorld {
     pub fn set_method(&mut self, m: crate::method::Method) -> Result<(), Error> {
         both!(self, w => w.set_method(m))
     }
+    /// Sets when the critters are laid out in memory (see [`crate::world::Locality`]).
+    pub fn set_locality(&mut self, locality: crate::world::Locality) {
+        both!(self, w => w.set_locality(locality))
+    }
+    /// True while the critters are stored elsewhere than their ids' slots.
+    pub fn is_laid_out(&self) -> bool {
+        both!(self, w => w.critters().is_arranged())
+    }
     /// What `auto` chose for the last step, and why.
     pub fn auto_choice(&self) -> Option<(crate::method::Method, crate::method::auto::Why)> {
         both!(self, w => w.auto_choice())

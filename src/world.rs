@@ -40,6 +40,34 @@ use std::time::{Duration, Instant};
 /// results do not depend on the number of threads).
 pub const PARALLEL_MIN: usize = 20_000;
 
+/// When the world lays its critters out in memory (see [`Locality`]), by default: every 200
+/// steps the layout is checked, from 50,000 critters on, and made anew when a quarter of them
+/// are out of order.
+pub const LOCALITY: Locality = Locality {
+    every: 200,
+    min_critters: 50_000,
+    disorder: 0.25,
+};
+
+/// When the world lays its critters out in memory along its grid's rows, so that critters near
+/// each other in space are near each other in memory, as the broad phase walks them (critters
+/// spawned in any order, or mixed by a long run, are otherwise scattered over 128 MB at a
+/// million). It changes where the critters are stored, never what happens: ids, the order of
+/// every hook call and of the response, the state hash and every recorded byte stay the same.
+/// Only under `discrete` and `substep:n`; the other methods keep state by slot and find the
+/// critters back in id order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Locality {
+    /// Steps between two layouts (0: never).
+    pub every: u64,
+    /// Fewest live critters for a layout (below, the critters fit in the caches anyway).
+    pub min_critters: usize,
+    /// Least share of critters out of order (more than a row away from the critter stored
+    /// before it) for a layout: critters spawned row by row, as the built-in scenes do, are
+    /// left where they are until they have mixed.
+    pub disorder: f64,
+}
+
 /// Steps with at least this many candidate pairs ask the rules and test the pairs in parallel
 /// chunks of [`INPUT_CHUNK`] pairs when there is more than one thread (joined in order: the same
 /// lists for any thread count; on one thread the chunks would only cost their copies).
@@ -281,6 +309,8 @@ pub struct World<V: Vector> {
     pub(crate) solve: crate::method::solve::Scratch<V>,
     /// Who sleeps under `solve:n` ([`crate::method::sleep`]).
     pub(crate) sleep: crate::method::sleep::Sleep<V>,
+    /// When the critters are laid out in memory.
+    locality: Locality,
 }
 
 impl<V: Vector> World<V> {
@@ -318,6 +348,7 @@ impl<V: Vector> World<V> {
             flight: Default::default(),
             solve: Default::default(),
             sleep: crate::method::sleep::Sleep::new(config.sleep),
+            locality: LOCALITY,
         })
     }
 
@@ -540,6 +571,17 @@ impl<V: Vector> World<V> {
         }
     }
 
+    /// Sets when the critters are laid out in memory along the grid (see [`Locality`]).
+    /// Changes speed only: every run gives the same bits whatever is set here.
+    pub fn set_locality(&mut self, locality: Locality) {
+        self.locality = locality;
+    }
+
+    /// When the critters are laid out in memory (see [`Locality`]).
+    pub fn locality(&self) -> Locality {
+        self.locality
+    }
+
     /// True when critters may sleep under `solve:n`.
     pub fn sleep_allowed(&self) -> bool {
         !self.sleep.off
@@ -547,7 +589,9 @@ impl<V: Vector> World<V> {
 
     /// True when critter `id` sleeps.
     pub fn is_asleep(&self, id: CritterId) -> bool {
-        self.critters.get(id).is_some() && self.sleep.asleep(id.index as usize)
+        self.critters
+            .slot_of(id)
+            .is_some_and(|slot| self.sleep.asleep(slot as usize))
     }
 
     /// How many critters sleep.
@@ -613,11 +657,11 @@ impl<V: Vector> World<V> {
     /// Total kinetic energy of the free critters, in four interleaved sums over the slots added
     /// in order ([`crate::critter_hash::totals`]: the recording's totals have the same bits).
     pub fn kinetic_energy(&self) -> f64 {
-        crate::critter_hash::totals(self.critters.slot_slice()).0
+        crate::critter_hash::totals(self.critters.in_id_order()).0
     }
     /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
-        crate::critter_hash::totals(self.critters.slot_slice()).1
+        crate::critter_hash::totals(self.critters.in_id_order()).1
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
@@ -662,8 +706,10 @@ impl<V: Vector> World<V> {
         // from the last hash when nothing could have written them; properties go to a hasher of
         // their own, after their owner's id.
         const _: () = assert!(crate::critter_hash::LANES.is_multiple_of(LANES));
-        let pass =
-            crate::critter_hash::hash_critters(self.critters.slot_slice(), self.critters.statics());
+        let pass = crate::critter_hash::hash_critters(
+            self.critters.in_id_order(),
+            self.critters.statics(),
+        );
         for half in pass.lanes.chunks_exact(LANES) {
             let mut w = [0u64; LANES];
             w.copy_from_slice(half);
@@ -867,12 +913,13 @@ impl<V: Vector> World<V> {
 
     /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
     pub fn remove(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
+        let slot = self.critters.slot_of(id).ok_or(Error::NoSuchCritter(id))?;
         let c = self.critters.remove(id).ok_or(Error::NoSuchCritter(id))?;
         if c.is_wall() {
             self.walls.retain(|&w| w != id);
         }
         // What rested on it wakes.
-        let gone = [(id.index as usize, c.pos, c.radius)];
+        let gone = [(slot as usize, c.pos, c.radius)];
         self.sleep
             .removed(&self.topo, &gone, self.critters.slot_slice());
         Ok(c)
@@ -900,9 +947,10 @@ impl<V: Vector> World<V> {
             .map(|c| c.kind)
             .ok_or(Error::NoSuchCritter(id))?;
         let hooks = self.kinds.get(kind).hooks.clone();
+        let me = self.critters.slot_of(id).ok_or(Error::NoSuchCritter(id))?;
         let mut ctx = UpdateCtx {
             access: self.access(),
-            me: id.index,
+            me,
         };
         hooks
             .init(&mut ctx)
@@ -938,6 +986,10 @@ impl<V: Vector> World<V> {
             }
             m => m,
         };
+        // The layout is for the broad phase's sake (which rebuilds its list after one).
+        let clock = Instant::now();
+        self.lay_out(method);
+        stats.broad_phase += clock.elapsed();
         if !matches!(method, Method::Solve(_)) {
             self.solve.warm.clear(); // kept only from one solve step to the next
         }
@@ -975,6 +1027,52 @@ impl<V: Vector> World<V> {
         self.totals.add(&stats);
         self.step_count += 1;
         Ok(())
+    }
+
+    /// Lays the critters out along the grid's rows when one is due under `method` (see
+    /// [`Locality`]), or back in id order for a method that keeps state by slot.
+    fn lay_out(&mut self, method: Method) {
+        let keeps_slots = matches!(self.method, Method::Discrete | Method::Substep(_))
+            && matches!(method, Method::Discrete | Method::Substep(_));
+        if !keeps_slots {
+            if self.critters.is_arranged() {
+                self.critters.unarrange();
+                self.broad.forget_list();
+            }
+            return;
+        }
+        let Locality {
+            every,
+            min_critters,
+            ..
+        } = self.locality;
+        if every == 0
+            || self.step_count == 0
+            || !self.step_count.is_multiple_of(every)
+            || self.critters.len() < min_critters.max(2)
+        {
+            return;
+        }
+        let set = &self.critters;
+        let (keys, per_row) = layout_keys(&self.topo, set.slot_slice(), set.len());
+        // Out of order: neighbours in memory more than a row apart.
+        let mut live = keys
+            .iter()
+            .filter(|&&k| k != u32::MAX)
+            .map(|&k| k / per_row);
+        let (mut pairs, mut apart) = (0usize, 0usize);
+        if let Some(mut last) = live.next() {
+            for row in live {
+                pairs += 1;
+                apart += usize::from(row.abs_diff(last) > 1);
+                last = row;
+            }
+        }
+        if (apart as f64) < self.locality.disorder * pairs as f64 {
+            return;
+        }
+        self.critters.arrange(&keys);
+        self.broad.forget_list();
     }
 
     /// Pop's step over `span` (dt, or what is left of it) without the update hooks and
@@ -1083,8 +1181,12 @@ impl<V: Vector> World<V> {
         }
         let dt = self.dt;
         let step = self.step_count;
-        for index in 0..self.critters.slot_count() as u32 {
-            let Some(c) = self.critters.slot(index) else {
+        // In id order, wherever the critters are stored.
+        for index in 0..self.critters.index_count() as u32 {
+            let Some(slot) = self.critters.slot_of_index(index) else {
+                continue;
+            };
+            let Some(c) = self.critters.slot(slot) else {
                 continue;
             };
             if !c.alive || !self.kinds.get(c.kind).has_update {
@@ -1094,7 +1196,7 @@ impl<V: Vector> World<V> {
             let hooks = self.kinds.get(kind).hooks.clone();
             let mut ctx = UpdateCtx {
                 access: self.access(),
-                me: index,
+                me: slot,
             };
             hooks
                 .update(&mut ctx, dt)
@@ -1166,7 +1268,7 @@ impl<V: Vector> World<V> {
                 if c.alive && c.is_wall() {
                     walls += 1;
                 } else {
-                    note(i, broad_object(c, 0.0).as_ref());
+                    note(i, broad_object(c, i as u32, 0.0).as_ref());
                 }
             }
             (seen, escapes, walls)
@@ -1213,7 +1315,7 @@ impl<V: Vector> World<V> {
             Some(m) => m.seen,
             None => self
                 .critters
-                .iter()
+                .iter_stored()
                 .fold(Survey::default(), |s, c| s.and(Survey::of(c))),
         };
         // New critters and changed priorities need their rule class (rare; sequential).
@@ -1240,14 +1342,19 @@ impl<V: Vector> World<V> {
             let mut escapes = m.escapes;
             let (mut walls, disks) = (0, escapes.slots.len());
             for &id in &self.walls {
-                if let Some(c) = self.critters.get(id).filter(|c| c.alive && c.is_wall()) {
+                let slot = self.critters.slot_of(id);
+                if let Some(slot) = slot.filter(|&s| {
+                    self.critters
+                        .slot(s)
+                        .is_some_and(|c| c.alive && c.is_wall())
+                }) {
                     walls += 1;
-                    let i = id.index as usize;
+                    let i = slot as usize;
                     if !self
                         .broad
                         .list_holds(&self.topo, i, objs.object(i).as_ref())
                     {
-                        escapes.slots.push(c.id.index);
+                        escapes.slots.push(slot);
                     }
                 }
             }
@@ -1306,8 +1413,8 @@ impl<V: Vector> World<V> {
                 .map_err(|e| at_step(e, self.step_count))?
             {
                 Some(rule) => {
-                    if let Some((caller, arg)) = roles_order(rule, ca, cb) {
-                        self.ruled.push((caller.id.index, arg.id.index, false));
+                    if let Some((caller, arg)) = roles_slots(rule, (a, ca), (b, cb)) {
+                        self.ruled.push((caller, arg, false));
                     }
                 }
                 // State-dependent rules are asked only for pairs that really touch.
@@ -1323,18 +1430,40 @@ impl<V: Vector> World<V> {
         self.narrow_phase_in_order()
     }
 
-    /// The contacts and wall pairs in the order of their lower slot, then their higher one: the
-    /// order the response takes them in, whatever order the broad phase found them in.
+    /// The contacts and wall pairs in the order of their lower id, then their higher one: the
+    /// order the response takes them in, whatever order the broad phase found them in, and
+    /// wherever the critters are stored.
     fn sort_contacts(&mut self) {
         let crowded = !self.contacts.is_empty()
             && LISTED_PER_CONTACT * self.contacts.len() >= self.broad.listed();
         self.broad.set_crowded(crowded);
-        let slots = self.critters.slot_count();
-        if !sort_pairs(&mut self.contacts, slots) && self.contacts.len() >= RADIX_MIN && crowded {
+        let arranged = self.critters.is_arranged();
+        // Stored elsewhere than their ids say: sorted as id indices, then back to slots.
+        let slots = self.critters.slot_slice();
+        let index = |s: u32| slots[s as usize].as_ref().map_or(u32::MAX, |c| c.id.index);
+        if arranged {
+            for p in &mut self.contacts {
+                *p = (index(p.0), index(p.1));
+            }
+        }
+        let n = self.critters.index_count().max(self.critters.slot_count());
+        if !sort_pairs(&mut self.contacts, n) && self.contacts.len() >= RADIX_MIN && crowded {
             self.broad.sort_list();
         }
+        if arranged {
+            let set = &self.critters;
+            let slot = |i: u32| set.slot_of_index(i).unwrap_or(u32::MAX);
+            for p in &mut self.contacts {
+                *p = (slot(p.0), slot(p.1));
+            }
+        }
         let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-        self.wall_pairs.sort_unstable_by_key(|&(c, a, _)| key(c, a));
+        if arranged {
+            self.wall_pairs
+                .sort_unstable_by_key(|&(c, a, _)| key(index(c), index(a)));
+        } else {
+            self.wall_pairs.sort_unstable_by_key(|&(c, a, _)| key(c, a));
+        }
     }
 
     /// The rules and narrow stages in one pass over the candidates, which reads each pair's
@@ -1399,8 +1528,8 @@ impl<V: Vector> World<V> {
             if ask {
                 let rule = crate::rules::roles_of(&self.kinds, topo, a, b)
                     .map_err(|e| at_step(e, self.step_count))?;
-                if let Some((caller, arg)) = roles_order(rule, a, b) {
-                    self.contacts.push((caller.id.index, arg.id.index));
+                if let Some(pair) = roles_slots(rule, (first, a), (second, b)) {
+                    self.contacts.push(pair);
                 }
             } else {
                 self.contacts.push((first, second));
@@ -1486,7 +1615,7 @@ impl<V: Vector> World<V> {
         }
         let rule = crate::rules::roles_of(&self.kinds, &self.topo, a, b)
             .map_err(|e| at_step(e, self.step_count))?;
-        Ok(roles_order(rule, a, b).map(|(c, x)| (c.id.index, x.id.index)))
+        Ok(roles_slots(rule, (first, a), (second, b)))
     }
 
     /// Calls the caller's `collide` on a touching pair, if both are still alive.
@@ -1543,12 +1672,13 @@ impl<V: Vector> World<V> {
         let mut gone = Vec::new();
         for id in std::mem::take(&mut self.pending.deaths) {
             self.events.deaths.push(id);
-            if let Some(c) = self.critters.remove(id) {
+            let slot = self.critters.slot_of(id);
+            if let (Some(slot), Some(c)) = (slot, self.critters.remove(id)) {
                 if c.is_wall() {
                     self.walls.retain(|&w| w != id);
                 }
                 if self.sleep.active {
-                    gone.push((id.index as usize, c.pos, c.radius));
+                    gone.push((slot as usize, c.pos, c.radius));
                 }
             }
         }
@@ -1562,6 +1692,59 @@ impl<V: Vector> World<V> {
         }
         Ok(())
     }
+}
+
+/// By slot, the key of each critter's place in the layout (`u32::MAX` for an empty slot only),
+/// and the keys per row.
+///
+/// The layout follows the broad phase's grid, whose cells run along x, then y, then z: the box
+/// is cut into rows along x, two mean spacings of the critters high (and deep in 3D), taken one
+/// after the other as the grid's cells are, and each row's critters are ordered by x. The pair
+/// walk of the grid, and of the list it builds, then goes through the critters nearly in memory
+/// order.
+fn layout_keys<V: Vector>(
+    topo: &Topology<V>,
+    slots: &[Option<Critter<V>>],
+    live: usize,
+) -> (Vec<u32>, u32) {
+    use rayon::prelude::*;
+    let (min, size) = (topo.min, topo.max - topo.min);
+    let volume: f64 = (0..V::DIM).map(|axis| size.get(axis)).product();
+    let spacing = (volume / live.max(1) as f64).powf(1.0 / V::DIM as f64);
+    // Rows along x over the other axes, at most 2^16 of them in all.
+    let mut height = 2.0 * spacing;
+    let rows_on = |height: f64, axis: usize| (size.get(axis) / height).ceil().max(1.0);
+    let rows = |height: f64| {
+        (1..V::DIM)
+            .map(|axis| rows_on(height, axis))
+            .product::<f64>()
+    };
+    while rows(height) > 65_536.0 {
+        height *= 2.0;
+    }
+    let row_count = rows(height) as u64;
+    // Steps along x within a row: the keys of all rows fit below u32::MAX.
+    let steps = (u64::from(u32::MAX - 1) / row_count).max(1) as f64;
+    let key = |c: &Critter<V>| {
+        let mut row = 0.0;
+        for axis in (1..V::DIM).rev() {
+            let n = rows_on(height, axis);
+            // NaN and positions outside the box clamp to its edges.
+            let r = ((c.pos.get(axis) - min.get(axis)) / height)
+                .floor()
+                .clamp(0.0, n - 1.0);
+            row = row * n + if r.is_nan() { 0.0 } else { r };
+        }
+        let t = (c.pos.get(0) - min.get(0)) / size.get(0);
+        let x = (t * steps).floor().clamp(0.0, steps - 1.0);
+        let x = if x.is_nan() { 0.0 } else { x };
+        ((row * steps + x) as u64).min(u64::from(u32::MAX - 1)) as u32
+    };
+    let keys = slots
+        .par_iter()
+        .map(|c| c.as_ref().map_or(u32::MAX, key))
+        .collect();
+    (keys, steps as u32)
 }
 
 /// Sets the step of a hook error raised where the step was not known.
@@ -1613,15 +1796,15 @@ fn rules_and_narrow<V: Vector>(
         let (Some(ca), Some(cb)) = (critters.slot(a), critters.slot(b)) else {
             continue;
         };
-        let (first, second, ask) = match rules.cached(ca.class, cb.class)? {
-            Some(rule) => match roles_order(rule, ca, cb) {
-                Some((caller, arg)) => (caller, arg, false),
+        let (pair, ask) = match rules.cached(ca.class, cb.class)? {
+            Some(rule) => match roles_slots(rule, (a, ca), (b, cb)) {
+                Some(pair) => (pair, false),
                 None => continue,
             },
-            None => (ca, cb, true),
+            None => ((a, b), true),
         };
         ruled += 1;
-        let pair = (first.id.index, second.id.index);
+        let (first, second) = if pair.0 == a { (ca, cb) } else { (cb, ca) };
         if first.is_wall() || second.is_wall() {
             // Tested in the response, once the disk pairs have moved.
             walls.push((pair.0, pair.1, ask));
@@ -1640,6 +1823,22 @@ fn rules_and_narrow<V: Vector>(
     }
     contacts.truncate(end);
     Some(ruled)
+}
+
+/// [`roles_order`] for critters `ca` in slot `a` and `cb` in slot `b`: the slots of (caller, arg).
+#[inline]
+pub(crate) fn roles_slots<V: Vector>(
+    rule: PairRule,
+    (a, ca): (u32, &Critter<V>),
+    (b, cb): (u32, &Critter<V>),
+) -> Option<(u32, u32)> {
+    roles_order(rule, ca, cb).map(|(caller, _)| {
+        if std::ptr::eq(caller, ca) {
+            (a, b)
+        } else {
+            (b, a)
+        }
+    })
 }
 
 /// (caller, arg) for a pair under `rule`, or `None` when they don't collide.
@@ -1684,14 +1883,14 @@ fn hook_error<V: Vector>(
 /// A live critter's box for the broad phase, a wall's widened by `wall_pad`. Only a wall's box
 /// is read from its shape, so a disk's second cache line stays untouched.
 #[inline]
-fn broad_object<V: Vector>(c: &Critter<V>, wall_pad: f64) -> Option<BroadObject<V>> {
+fn broad_object<V: Vector>(c: &Critter<V>, slot: u32, wall_pad: f64) -> Option<BroadObject<V>> {
     if !c.alive {
         return None;
     }
     let mut o = BroadObject {
         center: c.pos,
         half: V::splat(c.radius),
-        slot: c.id.index,
+        slot,
         is_wall: c.is_wall(),
     };
     if o.is_wall {
@@ -1723,7 +1922,7 @@ impl<V: Vector> Objects<V> for Slots<'_, V> {
         self.slots
             .get(i)?
             .as_ref()
-            .and_then(|c| broad_object(c, self.wall_pad))
+            .and_then(|c| broad_object(c, i as u32, self.wall_pad))
     }
 
     #[inline]
@@ -2020,9 +2219,8 @@ mod tests {
             .filter(|c| c.alive && !c.is_wall())
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        w.critters
-            .iter()
-            .filter_map(|c| broad_object(c, pad))
+        (0..w.critters.slot_count() as u32)
+            .filter_map(|i| broad_object(w.critters.slot(i)?, i, pad))
             .collect()
     }
 
@@ -2086,7 +2284,9 @@ mod tests {
                 let slots = w.critters.slot_slice();
                 let full: Vec<u32> = (0..slots.len())
                     .filter(|&i| {
-                        let o = slots[i].as_ref().and_then(|c| broad_object(c, 0.0));
+                        let o = slots[i]
+                            .as_ref()
+                            .and_then(|c| broad_object(c, i as u32, 0.0));
                         !w.broad.list_holds(&w.topo, i, o.as_ref())
                             && !slots[i].as_ref().is_some_and(|c| c.alive && c.is_wall())
                     })
@@ -2167,5 +2367,156 @@ mod tests {
             .iter()
             .any(|&(p, q)| p == id.index || q == id.index));
         assert!(!check_pairs(&mut w, "a quiet step"));
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use glam::DVec2;
+
+    fn gas(n: usize) -> World<DVec2> {
+        let params = crate::scenes::SceneParams {
+            n: Some(n),
+            ..Default::default()
+        };
+        match crate::scenes::builtin("gas", &params)
+            .expect("builds")
+            .world
+        {
+            crate::scenes::AnyWorld::D2(w) => w,
+            crate::scenes::AnyWorld::D3(_) => panic!("gas is 2D"),
+        }
+    }
+
+    /// Every id finds its own critter, iteration goes in id order, and the hash and totals are
+    /// those of the same critters in id order.
+    fn check_ids(w: &World<DVec2>, what: &str) {
+        let set = &w.critters;
+        let ids: Vec<CritterId> = set.iter().map(|c| c.id).collect();
+        assert_eq!(ids.len(), set.len(), "{what}: every critter once");
+        assert!(ids.is_sorted(), "{what}: iteration in id order");
+        for &id in &ids {
+            let slot = set.slot_of(id).expect("a slot");
+            assert_eq!(set.slot(slot).map(|c| c.id), Some(id), "{what}: {id}");
+            assert_eq!(set.get(id).map(|c| c.id), Some(id), "{what}: {id}");
+        }
+        // The same critters put back in id order: a set of their own, built from its parts.
+        let free: Vec<CritterId> = set.free_ids().collect();
+        let plain = CritterSet::from_parts(set.iter().cloned().collect(), &free).expect("parts");
+        assert!(!plain.is_arranged());
+        let (a, b) = (
+            crate::critter_hash::hash_critters(set.in_id_order(), set.statics()),
+            crate::critter_hash::hash_critters(plain.in_id_order(), plain.statics()),
+        );
+        assert_eq!((a.lanes, a.props), (b.lanes, b.props), "{what}: hash");
+        assert_eq!(
+            (a.energy.to_bits(), a.momentum),
+            (b.energy.to_bits(), b.momentum),
+            "{what}: totals"
+        );
+    }
+
+    /// `arrange` puts the critters in the order of their keys, with the empty slots dropped and
+    /// ids unchanged; spawns, removals and `unarrange` after it keep every id on its critter.
+    #[test]
+    fn critters_laid_out_keep_their_ids() {
+        let mut w = gas(400);
+        for i in (10..300).step_by(7) {
+            let id = w.critters.slot(i).expect("a critter").id;
+            w.remove(id).expect("removed");
+        }
+        let live = w.critters.len();
+        assert!(w.critters.slot_count() > live, "test setup: empty slots");
+        check_ids(&w, "before");
+        // Keys that reverse the slots' order, the empty slots marked.
+        let keys: Vec<u32> = (0..w.critters.slot_count())
+            .map(|s| match w.critters.slot(s as u32) {
+                Some(_) => 1_000_000 - s as u32,
+                None => u32::MAX,
+            })
+            .collect();
+        let before: Vec<CritterId> = w.critters.iter_stored().map(|c| c.id).collect();
+        w.critters.arrange(&keys);
+        assert!(w.critters.is_arranged());
+        assert_eq!(w.critters.slot_count(), live, "empty slots dropped");
+        let after: Vec<CritterId> = w.critters.iter_stored().map(|c| c.id).collect();
+        assert_eq!(
+            after,
+            before.into_iter().rev().collect::<Vec<_>>(),
+            "keys' order"
+        );
+        check_ids(&w, "arranged");
+        // A spawn takes a free id and a new slot at the end; a removal leaves a gap.
+        let spawned = w
+            .spawn(CritterSpec::ball(DVec2::new(3.0, 3.0)))
+            .expect("spawns");
+        assert_eq!(w.critters.slot_of(spawned), Some(live as u32));
+        check_ids(&w, "spawned");
+        let gone = after[5];
+        w.remove(gone).expect("removed");
+        assert!(w.critters.get(gone).is_none() && w.critters.slot_of(gone).is_none());
+        check_ids(&w, "removed");
+        w.critters.unarrange();
+        assert!(!w.critters.is_arranged());
+        for c in w.critters.iter() {
+            assert_eq!(
+                w.critters.slot_of(c.id),
+                Some(c.id.index),
+                "back in id order"
+            );
+        }
+        check_ids(&w, "unarranged");
+    }
+
+    /// The world's own layout follows the grid's rows: critters stored in a shuffled order
+    /// (far apart in space when next to each other in memory) are laid out at the next check,
+    /// after which neighbours in memory are about one spacing apart; critters spawned row by
+    /// row are left as they are. Neither changes the run.
+    #[test]
+    fn the_layout_puts_neighbours_in_space_next_to_each_other_in_memory() {
+        let checked = Locality {
+            every: 1,
+            min_critters: 0,
+            disorder: LOCALITY.disorder,
+        };
+        let gap = |w: &World<DVec2>| {
+            let cs: Vec<&Critter<DVec2>> = w.critters.iter_stored().filter(|c| !c.wall).collect();
+            let sum: f64 = cs.windows(2).map(|p| (p[0].pos - p[1].pos).length()).sum();
+            sum / (cs.len() - 1) as f64
+        };
+        let (mut shuffled, mut plain) = (gas(5_000), gas(5_000));
+        plain.set_locality(Locality {
+            every: 0,
+            ..checked
+        });
+        shuffled.set_locality(checked);
+        let keys: Vec<u32> = (0..shuffled.critters.slot_count() as u64)
+            .map(|s| (s.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 33) as u32)
+            .collect();
+        shuffled.critters.arrange(&keys);
+        shuffled.broad.forget_list();
+        let (before, spawned) = (gap(&shuffled), gap(&plain));
+        // The box is 140 wide: shuffled neighbours are some 70 apart, spawned ones a spacing (2)
+        // and a jump at the end of each row of 71 (2 more on average).
+        assert!(before > 30.0 && spawned < 5.0, "{before}, {spawned}");
+        for step in 0..3 {
+            shuffled.step().expect("steps");
+            plain.step().expect("steps");
+            assert_eq!(shuffled.state_hash(), plain.state_hash(), "step {step}");
+        }
+        let after = gap(&shuffled);
+        assert!(
+            after < 5.0,
+            "mean gap in memory {after} laid out, {before} shuffled"
+        );
+        // Spawned row by row, the gas is in order: checked every step, never laid out.
+        let mut spawned = gas(5_000);
+        spawned.set_locality(checked);
+        spawned.run(5).expect("runs");
+        assert!(
+            !spawned.critters.is_arranged(),
+            "a gas in order is left alone"
+        );
     }
 }
