@@ -117,6 +117,10 @@ impl AnyWorld {
     pub fn border(&self) -> Border {
         both!(self, w => w.topology().border)
     }
+    /// How many times the critters were laid out in memory along the grid.
+    pub fn layouts(&self) -> u64 {
+        both!(self, w => w.layouts())
+    }
     /// How many times the broad phase rebuilt its Verlet list.
     pub fn broad_phase_rebuilds(&self) -> u64 {
         both!(self, w => w.broad_phase_rebuilds())

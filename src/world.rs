@@ -311,6 +311,8 @@ pub struct World<V: Vector> {
     pub(crate) sleep: crate::method::sleep::Sleep<V>,
     /// When the critters are laid out in memory.
     locality: Locality,
+    /// How many times they were (diagnostics).
+    layouts: u64,
 }
 
 impl<V: Vector> World<V> {
@@ -349,6 +351,7 @@ impl<V: Vector> World<V> {
             solve: Default::default(),
             sleep: crate::method::sleep::Sleep::new(config.sleep),
             locality: LOCALITY,
+            layouts: 0,
         })
     }
 
@@ -634,6 +637,11 @@ impl<V: Vector> World<V> {
     /// The touching pairs of the last step as (caller, arg) slot indices, in response order.
     pub fn contact_pairs(&self) -> &[(u32, u32)] {
         &self.contacts
+    }
+    /// How many times the critters were laid out in memory along the grid (diagnostics; see
+    /// [`Locality`]).
+    pub fn layouts(&self) -> u64 {
+        self.layouts
     }
     /// How many times the broad phase rebuilt its Verlet list (diagnostics).
     pub fn broad_phase_rebuilds(&self) -> u64 {
@@ -1073,6 +1081,7 @@ impl<V: Vector> World<V> {
         }
         self.critters.arrange(&keys);
         self.broad.forget_list();
+        self.layouts += 1;
     }
 
     /// Pop's step over `span` (dt, or what is left of it) without the update hooks and

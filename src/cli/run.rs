@@ -411,6 +411,16 @@ fn stats(
             world.broad_phase_repairs()
         )?;
     }
+    if world.layouts() > 0 {
+        writeln!(
+            out,
+            "layout       the critters laid out along the grid {} (docs/ARCHITECTURE.md, \"Ids and slots\")",
+            match world.layouts() {
+                1 => "once".to_string(),
+                n => format!("{n} times"),
+            }
+        )?;
+    }
     if grid_steps > 0 {
         writeln!(
             out,
