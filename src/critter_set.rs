@@ -442,13 +442,9 @@ impl<V: Vector> CritterSet<V> {
         Some(set)
     }
 
-    /// The critters, in id order, mutably.
+    /// The critters, mutably, in slot order: id order unless [`CritterSet::is_arranged`].
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
         self.statics.forget();
-        if !self.place.is_empty() {
-            // Slot order is id order again (a rare call: scripts and tests).
-            self.unarrange();
-        }
         self.iter_mut_moving()
     }
 
