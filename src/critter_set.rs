@@ -141,16 +141,11 @@ impl<V: Vector> CritterSet<V> {
     /// The slot of critter `id`, if it is there.
     #[inline]
     pub fn slot_of(&self, id: CritterId) -> Option<u32> {
-        let i = id.index as usize;
-        let slot = if self.place.is_empty() {
-            id.index
-        } else {
-            *self.place.get(i)?
-        };
-        match self.slots.get(slot as usize) {
-            Some(Some(c)) if c.id == id => Some(slot),
-            _ => None,
-        }
+        self.slot_of_index(id.index).filter(|&slot| {
+            self.slots[slot as usize]
+                .as_ref()
+                .is_some_and(|c| c.id == id)
+        })
     }
 
     /// How many id indices there are (live or free): id indices are below this.
@@ -255,17 +250,7 @@ impl<V: Vector> CritterSet<V> {
     /// Removes critter `id`, if it is there. O(1).
     pub fn remove(&mut self, id: CritterId) -> Option<Critter<V>> {
         let i = id.index as usize;
-        if self.generations.get(i) != Some(&id.generation) {
-            return None;
-        }
-        let slot = if self.place.is_empty() {
-            i
-        } else {
-            self.place[i] as usize
-        };
-        if !matches!(self.slots.get(slot), Some(Some(c)) if c.id == id) {
-            return None;
-        }
+        let slot = self.slot_of(id)? as usize;
         self.statics.forget();
         let critter = self.slots[slot].take()?;
         if !self.place.is_empty() {
