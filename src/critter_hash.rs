@@ -4,15 +4,15 @@
 //! Recording hashes every step, so this pass must cost little next to a step. Each critter is
 //! sixteen words ([`words`]): position, velocity, radius, mass, id, a word of flags (fixed,
 //! alive), kind, priority, restitution and health, the rest zero. Each word goes through a lane
-//! of its own, `lane = (rotl(lane, 5) ^ word) * K`, critter after critter in slot order. Each
+//! of its own, `lane = (rotl(lane, 5) ^ word) * K`, critter after critter in id order. Each
 //! update is a bijection of the lane for a fixed word and of the word for a fixed lane, so a
 //! change in any one word of any one critter always changes its lane, and the order of the
 //! critters counts.
 //!
 //! - The first [`MOVING`] words (position, velocity, radius, mass; in 2D also id and flags) are
 //!   all that a step without hooks changes. They go through [`SETS`] interleaved sets of lanes:
-//!   the critter in slot `i` through set `i % SETS`. One chain of multiplies per lane would make
-//!   every critter wait for the last one's multiply; four chains run side by side.
+//!   the critter of id index `i` through set `i % SETS`. One chain of multiplies per lane would
+//!   make every critter wait for the last one's multiply; four chains run side by side.
 //! - The other words go through one set of lanes, which the critter set keeps between hashes
 //!   until something may have written them ([`Statics`]). A step of a scene without hooks then
 //!   reads one cache line of each 2D critter, not two.
@@ -176,8 +176,8 @@ impl<V: Vector> Sums<V> {
     }
 }
 
-/// The kinetic energy and momentum of the free critters of `slots`, summed as every pass sums
-/// them: the critter in slot `i` into sum `i % SETS`, the sums added in order.
+/// The kinetic energy and momentum of the free `critters`, summed as every pass sums them: the
+/// critter of id index `i` into sum `i % SETS`, the sums added in order.
 pub fn totals<V: Vector>(critters: InIdOrder<'_, V>) -> (f64, V) {
     let mut sums = Sums::new();
     for_each_in_sets(critters, |s, c| sums.add(s, c));
@@ -195,9 +195,9 @@ pub struct Pass<V> {
     pub momentum: V,
 }
 
-/// Calls `f(s, c)` for every critter `c` of `slots` in slot order, `s` its slot index modulo
-/// [`SETS`], with `s` a constant in the unrolled main loop (so sets indexed by it stay in
-/// registers).
+/// Calls `f(s, c)` for every critter `c` in id order, `s` its id index modulo [`SETS`], with
+/// `s` a constant in the unrolled main loop while slot and id index are the same (so sets
+/// indexed by it stay in registers).
 #[inline(always)]
 fn for_each_in_sets<V: Vector>(critters: InIdOrder<'_, V>, mut f: impl FnMut(usize, &Critter<V>)) {
     if !critters.place.is_empty() {
