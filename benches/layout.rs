@@ -44,7 +44,7 @@ fn build(n: usize, shuffled: bool) -> World<DVec2> {
                 CritterSpec::ball(c.pos)
                     .vel(c.vel)
                     .radius(c.radius())
-                    .restitution(c.restitution),
+                    .restitution(c.restitution()),
             ),
         }
     }

@@ -1756,7 +1756,7 @@ impl<V: Vector> BroadPhase<V> {
             w
         };
         // Each object's level is measured from the finest width `s0`, which takes a pass over
-        // the objects of its own (at 1e6 the world's are critters 128 bytes apart). The levels
+        // the objects of its own (at 1e6 the world's are 2D critters 64 bytes apart). The levels
         // are first found from the last build's `s0`, in the same pass that finds the new one:
         // where the two are equal (a scene whose smallest objects stay the same size), that is
         // the only pass. On rayon's threads for a large scene, in fixed chunks: a minimum and

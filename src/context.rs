@@ -107,13 +107,13 @@ impl<V: Vector> Access<'_, V> {
     pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {
         self.critters
             .get(id)
-            .is_some_and(|c| self.kinds.is_kind(c.kind, kind))
+            .is_some_and(|c| self.kinds.is_kind(c.kind(), kind))
     }
     /// Live critters of `kind` (or kinds extending it), in id order. O(N).
     pub fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
         self.critters
             .iter()
-            .filter(|c| c.alive && self.kinds.is_kind(c.kind, kind))
+            .filter(|c| c.alive && self.kinds.is_kind(c.kind(), kind))
             .map(|c| c.id)
             .collect()
     }
@@ -130,9 +130,9 @@ impl<V: Vector> Access<'_, V> {
     pub fn damage(&mut self, id: CritterId, amount: f64) {
         let dead = match self.critters.get_mut(id) {
             Some(c) if c.alive => {
-                c.health -= amount;
+                c.traits_mut().health -= amount;
                 self.events.damages.push((id, amount));
-                c.health <= 0.0
+                c.health() <= 0.0
             }
             _ => false,
         };

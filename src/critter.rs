@@ -6,6 +6,7 @@ use crate::wall::WallBox;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt;
+use std::sync::Arc;
 
 /// Collide priority of the lowest critters (Pop's CP_MINIMUM).
 pub const CP_MINIMUM: f64 = 0.0;
@@ -98,16 +99,16 @@ pub(crate) const CLASS_UNSET: u32 = u32::MAX;
 
 /// One critter.
 ///
-/// Position, velocity, restitution, health and properties are free to change. Radius, mass,
-/// priority and `fixed` go through setters, because the engine caches what follows from them
-/// (the rule class of the pair cache).
+/// Position and velocity are free to change; restitution, health and properties through their
+/// setters. Radius, mass, priority and `fixed` go through setters too, because the engine caches
+/// what follows from them (the rule class of the pair cache).
 ///
-/// The fields are laid out by hand (`repr(C)`): what the broad and narrow phases read for every
-/// candidate pair (position, velocity, radius, mass, id, rule class, fixed, alive) comes first,
-/// and in 2D the struct is 128 bytes aligned to 64, so those fields are one cache line. A pair
-/// test on a large scene then misses the cache once per critter instead of twice (`alive`, which
-/// `Option<Critter>` uses as its tag, was at the far end). 3D keeps 8-byte alignment (its hot
-/// fields do not fit in one line, and 64-byte alignment would make it 192 bytes).
+/// The record holds what the passes over every critter read (the move, the broad phase's
+/// re-test, the narrow phase): position, velocity, radius, id, rule class, fixed, alive and the
+/// wall flag, laid out by hand (`repr(C)`). In 2D it is 64 bytes aligned to 64, one cache line;
+/// 80 bytes in 3D. The rest, [`Traits`], sits behind a shared pointer: critters alike (a gas
+/// spawned from one kind) share one copy, and a change makes the changed critter its own (see
+/// [`Critter::traits_mut`]). A pass over a million 2D critters then streams 64 MB, not 128.
 #[derive(Clone, Debug)]
 #[repr(C)]
 pub struct Critter<V: Vector> {
@@ -116,25 +117,48 @@ pub struct Critter<V: Vector> {
     /// Velocity.
     pub vel: V,
     pub(crate) radius: f64,
-    pub(crate) mass: f64,
     pub(crate) id: CritterId,
     pub(crate) class: u32,
     pub(crate) fixed: bool,
     pub(crate) alive: bool,
-    /// True for a wall: what `shape` says, kept in the first cache line so that the passes
-    /// over every critter (move, hash) need not read the second one. Not hashed (the kind
-    /// says it too).
+    /// True for a wall: what the shape says, kept in the record so that the passes over every
+    /// critter need not read the traits. Not hashed (the kind says it too).
     pub(crate) wall: bool,
+    pub(crate) traits: Arc<Traits<V>>,
+    pub(crate) _align: [V::CritterAlign; 0],
+}
+
+/// What a critter is, beside where it is and how it moves: read per touching pair and by the
+/// hooks, not by the passes over every critter. Shared between critters alike (see
+/// [`Critter`]).
+#[derive(Clone, Debug)]
+pub(crate) struct Traits<V: Vector> {
     pub(crate) kind: KindId,
+    pub(crate) mass: f64,
     pub(crate) priority: f64,
     /// Coefficient of restitution in [0, 1]; a pair uses the smaller of its two.
-    pub restitution: f64,
+    pub(crate) restitution: f64,
     /// Health; `damage` lowers it and the critter dies at or below zero.
-    pub health: f64,
+    pub(crate) health: f64,
     pub(crate) shape: Shape<V>,
     /// User properties.
-    pub props: Props,
-    pub(crate) _align: [V::CritterAlign; 0],
+    pub(crate) props: Props,
+}
+
+impl<V: Vector> Traits<V> {
+    /// True when `self` and `o` are the same bit for bit, as far as it is cheap to tell: disks
+    /// with no properties (what a spawned gas is). Two traits that are told apart here may
+    /// still be shared; they are then not.
+    pub(crate) fn same_plain(&self, o: &Self) -> bool {
+        matches!((&self.shape, &o.shape), (Shape::Disk, Shape::Disk))
+            && self.props.is_empty()
+            && o.props.is_empty()
+            && self.kind == o.kind
+            && self.mass.to_bits() == o.mass.to_bits()
+            && self.priority.to_bits() == o.priority.to_bits()
+            && self.restitution.to_bits() == o.restitution.to_bits()
+            && self.health.to_bits() == o.health.to_bits()
+    }
 }
 
 impl<V: Vector> Critter<V> {
@@ -144,7 +168,7 @@ impl<V: Vector> Critter<V> {
     }
     /// Kind.
     pub fn kind(&self) -> KindId {
-        self.kind
+        self.traits.kind
     }
     /// Radius (for a wall: the radius of its bounding sphere).
     pub fn radius(&self) -> f64 {
@@ -152,19 +176,19 @@ impl<V: Vector> Critter<V> {
     }
     /// Mass. Fixed critters have a finite nominal mass but act as infinitely heavy.
     pub fn mass(&self) -> f64 {
-        self.mass
+        self.traits.mass
     }
     /// 1 / mass, or 0 when fixed.
     pub fn inv_mass(&self) -> f64 {
         if self.fixed {
             0.0
         } else {
-            1.0 / self.mass
+            1.0 / self.traits.mass
         }
     }
     /// Collide priority (see `CP_*`).
     pub fn priority(&self) -> f64 {
-        self.priority
+        self.traits.priority
     }
     /// Fixed critters have infinite mass: collisions never change their velocity.
     pub fn is_fixed(&self) -> bool {
@@ -176,26 +200,26 @@ impl<V: Vector> Critter<V> {
     }
     /// True for walls.
     pub fn is_wall(&self) -> bool {
-        debug_assert_eq!(self.wall, matches!(self.shape, Shape::Wall(_)));
+        debug_assert_eq!(self.wall, matches!(self.traits.shape, Shape::Wall(_)));
         self.wall
     }
     /// The wall geometry, for walls.
     pub fn wall(&self) -> Option<&WallBox<V>> {
-        match &self.shape {
+        match &self.traits.shape {
             Shape::Wall(w) => Some(w),
             Shape::Disk => None,
         }
     }
     /// Shape.
     pub fn shape(&self) -> &Shape<V> {
-        &self.shape
+        &self.traits.shape
     }
     /// Kinetic energy (zero for fixed critters, which are not part of the dynamics).
     pub fn kinetic_energy(&self) -> f64 {
         if self.fixed {
             0.0
         } else {
-            0.5 * self.mass * self.vel.length_squared()
+            0.5 * self.traits.mass * self.vel.length_squared()
         }
     }
 
@@ -216,7 +240,7 @@ impl<V: Vector> Critter<V> {
     /// Sets the mass (finite and > 0).
     pub fn set_mass(&mut self, mass: f64) -> Result<(), crate::Error> {
         check_positive(|| self.describe(), "mass", mass)?;
-        self.mass = mass;
+        self.traits_mut().mass = mass;
         Ok(())
     }
     /// Makes the critter fixed (infinite mass) or free.
@@ -237,9 +261,47 @@ impl<V: Vector> Critter<V> {
                 reason: "must be a finite number; use the CP_* constants".into(),
             });
         }
-        self.priority = priority;
+        self.traits_mut().priority = priority;
         self.class = CLASS_UNSET;
         Ok(())
+    }
+
+    /// Coefficient of restitution in [0, 1]; a pair uses the smaller of its two.
+    pub fn restitution(&self) -> f64 {
+        self.traits.restitution
+    }
+    /// Sets the coefficient of restitution (in [0, 1]).
+    pub fn set_restitution(&mut self, restitution: f64) -> Result<(), crate::Error> {
+        if !(0.0..=1.0).contains(&restitution) {
+            return Err(crate::Error::InvalidCritter {
+                critter: self.describe(),
+                field: "restitution",
+                value: restitution.to_string(),
+                reason: "must be between 0 (sticky) and 1 (elastic)".into(),
+            });
+        }
+        self.traits_mut().restitution = restitution;
+        Ok(())
+    }
+    /// Health; `damage` lowers it and the critter dies at or below zero.
+    pub fn health(&self) -> f64 {
+        self.traits.health
+    }
+    /// Sets the health (any number; the lifecycle, not this, decides who dies).
+    pub fn set_health(&mut self, health: f64) {
+        self.traits_mut().health = health;
+    }
+    /// User properties.
+    pub fn props(&self) -> &Props {
+        &self.traits.props
+    }
+    /// User properties, to change.
+    pub fn props_mut(&mut self) -> &mut Props {
+        &mut self.traits_mut().props
+    }
+    /// The traits to change: the critter's own copy, made now if it shares them.
+    pub(crate) fn traits_mut(&mut self) -> &mut Traits<V> {
+        Arc::make_mut(&mut self.traits)
     }
 
     /// "critter #3" — for error messages.
@@ -367,29 +429,14 @@ mod layout_tests {
     use std::mem::{align_of, offset_of, size_of};
 
     #[test]
-    fn a_2d_critter_is_two_cache_lines_with_the_pair_fields_in_the_first() {
+    fn a_2d_critter_is_one_cache_line_and_a_3d_one_80_bytes() {
         type C = Critter<DVec2>;
-        assert_eq!(size_of::<C>(), 128);
+        assert_eq!(size_of::<C>(), 64);
         assert_eq!(align_of::<C>(), 64);
         // The slot's tag lives in the critter (no extra word for `Option`).
-        assert_eq!(size_of::<Option<C>>(), 128);
-        for (field, end) in [
-            ("pos", offset_of!(C, pos) + 16),
-            ("vel", offset_of!(C, vel) + 16),
-            ("radius", offset_of!(C, radius) + 8),
-            ("mass", offset_of!(C, mass) + 8),
-            ("id", offset_of!(C, id) + 8),
-            ("class", offset_of!(C, class) + 4),
-            ("fixed", offset_of!(C, fixed) + 1),
-            ("alive", offset_of!(C, alive) + 1),
-        ] {
-            assert!(end <= 64, "{field} ends at byte {end}");
-        }
-    }
-
-    #[test]
-    fn a_3d_critter_is_not_padded_to_a_cache_line() {
+        assert_eq!(size_of::<Option<C>>(), 64);
         assert_eq!(align_of::<Critter<DVec3>>(), 8);
-        assert!(size_of::<Option<Critter<DVec3>>>() <= 144);
+        assert_eq!(size_of::<Option<Critter<DVec3>>>(), 80);
+        assert!(offset_of!(C, traits) + 8 <= 64);
     }
 }

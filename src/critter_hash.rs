@@ -15,15 +15,16 @@
 //!   make every critter wait for the last one's multiply; four chains run side by side.
 //! - The other words go through one set of lanes, which the critter set keeps between hashes
 //!   until something may have written them ([`Statics`]). A step of a scene without hooks then
-//!   reads one cache line of each 2D critter, not two.
+//!   reads each critter's record and the mass in its traits (shared by critters alike), not
+//!   the rest of the traits.
 //! - The totals (kinetic energy, momentum) are summed in [`SETS`] interleaved sums too, added in
 //!   set order at the end ([`totals`], which [`crate::world::World::kinetic_energy`] uses).
 //!
-//! The words are the critter's fields in memory order (`repr(C)`, eight bytes a word, with the
-//! rule class, the wall flag and padding read as zero), so on a CPU with AVX-512 a critter's first eight words
-//! are one byte-masked load into one vector register, and its step one rotate-xor-multiply.
-//! Elsewhere the same arithmetic runs one lane at a time. Both give the same bits; the tests
-//! compare them on 2D and 3D worlds with every bit of every field flipped in turn.
+//! The words are eight bytes each, with the rule class, the wall flag and padding left out. On a
+//! CPU with AVX-512 a critter's first eight words are one byte-masked load of its record, a
+//! permutation and the mass put in its lane, and its step one rotate-xor-multiply of eight
+//! lanes. Elsewhere the same arithmetic runs one lane at a time. Both give the same bits; the
+//! tests compare them on 2D and 3D worlds with every bit of every field flipped in turn.
 
 use crate::critter::{Critter, PropValue};
 use crate::critter_set::InIdOrder;
@@ -127,13 +128,13 @@ pub fn words<V: Vector>(c: &Critter<V>) -> [u64; WORDS] {
     }
     let rest = [
         f(c.radius),
-        f(c.mass),
+        f(c.mass()),
         id_word(c),
         flags_word(c),
-        c.kind.0 as u64,
-        f(c.priority),
-        f(c.restitution),
-        f(c.health),
+        c.kind().0 as u64,
+        f(c.priority()),
+        f(c.restitution()),
+        f(c.health()),
     ];
     w[2 * d..2 * d + rest.len()].copy_from_slice(&rest);
     w
@@ -159,7 +160,7 @@ impl<V: Vector> Sums<V> {
     fn add(&mut self, s: usize, c: &Critter<V>) {
         self.energy[s] += c.kinetic_energy();
         if !c.fixed {
-            self.momentum[s] += c.vel * c.mass;
+            self.momentum[s] += c.vel * c.mass();
         }
     }
 
@@ -258,7 +259,7 @@ pub fn portable_pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher
         for (lane, &w) in statics.iter_mut().zip(&w[MOVING..]) {
             *lane = mix(*lane, w);
         }
-        if !c.props.is_empty() {
+        if !c.props().is_empty() {
             hash_props(props, c);
         }
     });
@@ -286,6 +287,14 @@ fn moving_words<V: Vector>(c: &Critter<V>) -> [u64; MOVING] {
     // Inlined, the loads of the words not kept are dropped.
     let mut w = [0u64; MOVING];
     w.copy_from_slice(&words(c)[..MOVING]);
+    w
+}
+
+/// A critter's last [`STATIC`] words: the second half of [`words`].
+#[inline(always)]
+fn static_words<V: Vector>(c: &Critter<V>) -> [u64; STATIC] {
+    let mut w = [0u64; STATIC];
+    w.copy_from_slice(&words(c)[MOVING..]);
     w
 }
 
@@ -428,36 +437,80 @@ mod avx512 {
     use std::arch::x86_64::*;
     use std::mem::offset_of;
 
-    /// The bytes of the sixteen words that hold state, as two 64-bit load masks (one bit per
-    /// byte), if the critter's fields sit where [`words`] says; `None` otherwise.
-    pub(super) fn byte_masks<V: Vector>() -> Option<[u64; 2]> {
+    /// How the AVX-512 passes read a critter's first [`MOVING`] words from its record: one
+    /// byte-masked load of the record's first 64 bytes, a permutation of its eight words into
+    /// the order of [`words`], and the mass (in the traits) put in its lane.
+    #[derive(Clone, Copy, Debug)]
+    pub(super) struct MovingLoad {
+        /// The record's bytes that are read (one bit per byte).
+        mask: u64,
+        /// For each word of [`words`], the word of the record it comes from.
+        from: [u64; MOVING],
+        /// The word that is the mass.
+        mass: usize,
+    }
+
+    /// The [`MovingLoad`] for `V`'s layout, if every moving word but the mass lies whole in the
+    /// record's first 64 bytes at the byte of its word that [`words`] puts it at; `None`
+    /// otherwise (the passes then build the words field by field).
+    pub(super) fn moving_load<V: Vector>() -> Option<MovingLoad> {
         let d = V::DIM;
+        // (offset in the record, size, the byte of `words` it goes to).
         let word = |i: usize| 8 * i;
-        // (offset, size) of each field, and the byte [`words`] puts it at.
-        let fields = [
+        let mut fields = vec![
             (offset_of!(Critter<V>, pos), 8 * d, word(0)),
             (offset_of!(Critter<V>, vel), 8 * d, word(d)),
             (offset_of!(Critter<V>, radius), 8, word(2 * d)),
-            (offset_of!(Critter<V>, mass), 8, word(2 * d + 1)),
-            // Index, then generation (`repr(C)`), as [`super::id_word`] puts them.
-            (offset_of!(Critter<V>, id), 8, word(2 * d + 2)),
-            (offset_of!(Critter<V>, fixed), 1, word(2 * d + 3) + 4),
-            (offset_of!(Critter<V>, alive), 1, word(2 * d + 3) + 5),
-            (offset_of!(Critter<V>, kind), 4, word(2 * d + 4)),
-            (offset_of!(Critter<V>, priority), 8, word(2 * d + 5)),
-            (offset_of!(Critter<V>, restitution), 8, word(2 * d + 6)),
-            (offset_of!(Critter<V>, health), 8, word(2 * d + 7)),
         ];
-        let mut masks = [0u64; 2];
-        for (offset, size, at) in fields {
-            if offset != at || at + size > 128 {
+        let mass = 2 * d + 1;
+        if d == 2 {
+            // Index, then generation (`repr(C)`), as [`super::id_word`] puts them; then fixed
+            // and alive at bytes 4 and 5 of their word, as [`super::flags_word`] does.
+            fields.push((offset_of!(Critter<V>, id), 8, word(2 * d + 2)));
+            fields.push((offset_of!(Critter<V>, fixed), 1, word(2 * d + 3) + 4));
+            fields.push((offset_of!(Critter<V>, alive), 1, word(2 * d + 3) + 5));
+        }
+        let (mut mask, mut from, mut set) = (0u64, [0u64; MOVING], [false; MOVING]);
+        // Each field a word at a time (position and velocity are several).
+        let chunks = fields.into_iter().flat_map(|(offset, size, at)| {
+            (0..size.div_ceil(8)).map(move |k| (offset + 8 * k, (size - 8 * k).min(8), at + 8 * k))
+        });
+        for (offset, size, at) in chunks {
+            let (target, source) = (at / 8, offset / 8);
+            let fits = offset % 8 == at % 8 && offset + size <= 64 && at % 8 + size <= 8;
+            if !fits || target >= MOVING || (set[target] && from[target] != source as u64) {
                 return None;
             }
-            for byte in at..at + size {
-                masks[byte / 64] |= 1 << (byte % 64);
+            for byte in offset..offset + size {
+                mask |= 1 << byte;
             }
+            (from[target], set[target]) = (source as u64, true);
         }
-        Some(masks)
+        // The mass's lane takes a word with no byte read (zero) until the mass is put in.
+        let zero = (0..MOVING).find(|&w| (mask >> (8 * w)) & 0xff == 0)?;
+        from[mass] = zero as u64;
+        // Every other word of the first half is a field.
+        (set.iter().filter(|&&s| s).count() == MOVING - 1 && !set[mass]).then_some(MovingLoad {
+            mask,
+            from,
+            mass,
+        })
+    }
+
+    /// A critter's first [`MOVING`] words, as [`super::moving_words`] gives them.
+    ///
+    /// # Safety
+    /// `load` must come from [`moving_load`] for `V` (it reads only bytes of the record's
+    /// fields), and the CPU must have AVX-512F, DQ and BW.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    unsafe fn moving_vector<V: Vector>(c: &Critter<V>, load: &MovingLoad) -> __m512i {
+        let p: *const i8 = (c as *const Critter<V>).cast();
+        // SAFETY: the masked bytes are not read; the rest lie in initialised fields of the
+        // record (the caller's promise).
+        let record = unsafe { _mm512_maskz_loadu_epi8(load.mask, p) };
+        let words = _mm512_permutexvar_epi64(load8(&load.from), record);
+        _mm512_mask_set1_epi64(words, 1 << load.mass, c.mass().to_bits() as i64)
     }
 
     /// One rotate-xor-multiply of eight lanes.
@@ -485,73 +538,61 @@ mod avx512 {
         out
     }
 
-    /// A critter's words under `mask`, from byte `offset` of the critter.
-    ///
-    /// # Safety
-    /// `mask` must cover only bytes of the critter's fields from `offset` (see [`byte_masks`]).
-    #[inline]
-    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
-    unsafe fn load_masked<V: Vector>(c: &Critter<V>, offset: usize, mask: u64) -> __m512i {
-        let p: *const i8 = (c as *const Critter<V>).cast();
-        // SAFETY: masked bytes are not read; the rest are initialised fields (the caller's
-        // promise).
-        unsafe { _mm512_maskz_loadu_epi8(mask, p.add(offset)) }
-    }
-
     /// [`super::pass`] with each set of eight lanes in an AVX-512 register: each half of a
-    /// critter's words is one byte-masked load of its fields (masked bytes are not read, so
-    /// neither the rule class, the wall flag nor any padding is), then one rotate-xor-multiply.
+    /// critter's words is one rotate-xor-multiply of eight lanes at once.
     ///
     /// # Safety
     /// The CPU must have AVX-512F, DQ and BW.
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
     pub unsafe fn pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass<V> {
-        let Some([mask_a, mask_b]) = byte_masks::<V>() else {
+        let Some(load) = moving_load::<V>() else {
             return portable_pass(slots, props);
         };
         let k = _mm512_set1_epi64(K as i64);
-        let mut moving = [0; SETS].map(|s| load8(&start_moving(s)));
-        let mut statics = load8(&start_static());
+        // The lanes are kept as words, not as vectors: an array of vectors across the closure
+        // was stored to a stack slot the frame had not aligned to 64 bytes (a fault).
+        let mut moving = [0; SETS].map(start_moving);
+        let mut statics = start_static();
         let mut sums = Sums::new();
         for_each_in_sets(slots, |s, c| {
             sums.add(s, c);
-            // SAFETY: `byte_masks` checked every byte both loads read.
-            let (wa, wb) = unsafe { (load_masked(c, 0, mask_a), load_masked(c, 64, mask_b)) };
-            moving[s] = mix8(moving[s], wa, k);
-            statics = mix8(statics, wb, k);
-            if !c.props.is_empty() {
+            // SAFETY: `load` is `moving_load`'s for `V`.
+            let wa = unsafe { moving_vector(c, &load) };
+            moving[s] = store8(mix8(load8(&moving[s]), wa, k));
+            statics = store8(mix8(load8(&statics), load8(&static_words(c)), k));
+            if !c.props().is_empty() {
                 hash_props(props, c);
             }
         });
         let (energy, momentum) = sums.total();
         Pass {
-            lanes: join(moving.map(|v| store8(v)), store8(statics)),
+            lanes: join(moving, statics),
             energy,
             momentum,
         }
     }
 
-    /// [`super::moving_pass`]: one masked load and one rotate-xor-multiply per critter.
+    /// [`super::moving_pass`]: one rotate-xor-multiply of eight lanes per critter.
     ///
     /// # Safety
     /// The CPU must have AVX-512F, DQ and BW.
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
     pub unsafe fn moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
-        let Some([mask_a, _]) = byte_masks::<V>() else {
+        let Some(load) = moving_load::<V>() else {
             return portable_moving_pass(slots);
         };
         let k = _mm512_set1_epi64(K as i64);
-        let mut moving = [0; SETS].map(|s| load8(&start_moving(s)));
+        let mut moving = [0; SETS].map(start_moving);
         let mut sums = Sums::new();
         for_each_in_sets(slots, |s, c| {
             sums.add(s, c);
-            // SAFETY: `byte_masks` checked every byte the load reads.
-            let wa = unsafe { load_masked(c, 0, mask_a) };
-            moving[s] = mix8(moving[s], wa, k);
+            // SAFETY: `load` is `moving_load`'s for `V`.
+            let wa = unsafe { moving_vector(c, &load) };
+            moving[s] = store8(mix8(load8(&moving[s]), wa, k));
         });
         let (energy, momentum) = sums.total();
         MovingPass {
-            lanes: moving.map(|v| store8(v)),
+            lanes: moving,
             energy,
             momentum,
         }
@@ -562,8 +603,8 @@ mod avx512 {
 #[inline(never)]
 fn hash_props<V: Vector>(h: &mut StateHasher, c: &Critter<V>) {
     h.word(id_word(c));
-    h.word(c.props.len() as u64);
-    for (name, value) in &c.props {
+    h.word(c.props().len() as u64);
+    for (name, value) in c.props() {
         hash_bytes(h, name.as_bytes());
         hash_prop(h, value);
     }
@@ -693,10 +734,10 @@ mod tests {
         }
         let floats: [(&str, Float<V>); 5] = [
             ("radius", |c| &mut c.radius),
-            ("mass", |c| &mut c.mass),
-            ("priority", |c| &mut c.priority),
-            ("restitution", |c| &mut c.restitution),
-            ("health", |c| &mut c.health),
+            ("mass", |c| &mut c.traits_mut().mass),
+            ("priority", |c| &mut c.traits_mut().priority),
+            ("restitution", |c| &mut c.traits_mut().restitution),
+            ("health", |c| &mut c.traits_mut().health),
         ];
         for (name, field) in floats {
             fields.push((name.into(), 64, Box::new(move |c, b| flip(field(c), b))));
@@ -704,11 +745,11 @@ mod tests {
         let others: [(&str, u32, Other<V>); 6] = [
             ("id.index", 32, |c, b| c.id.index ^= 1 << b),
             ("id.generation", 32, |c, b| c.id.generation ^= 1 << b),
-            ("kind", 32, |c, b| c.kind.0 ^= 1 << b),
+            ("kind", 32, |c, b| c.traits_mut().kind.0 ^= 1 << b),
             ("fixed", 1, |c, _| c.fixed = !c.fixed),
             ("alive", 1, |c, _| c.alive = !c.alive),
             ("props", 1, |c, _| {
-                c.props.insert("tag".into(), PropValue::Int(1));
+                c.props_mut().insert("tag".into(), PropValue::Int(1));
             }),
         ];
         for (name, width, f) in others {
@@ -800,10 +841,14 @@ mod tests {
         type Write = fn(&mut World<glam::DVec2>, CritterId);
         let writes: [(&str, Write); 6] = [
             ("World::get_mut", |w, id| {
-                w.get_mut(id).expect("there").health -= 1.0
+                w.get_mut(id).expect("there").traits_mut().health -= 1.0
             }),
             ("CritterSet::get_mut", |w, id| {
-                w.critters.get_mut(id).expect("there").restitution = 0.5
+                w.critters
+                    .get_mut(id)
+                    .expect("there")
+                    .traits_mut()
+                    .restitution = 0.5
             }),
             ("CritterSet::slot_mut", |w, id| {
                 let c = w.critters.slot_mut(id.index).expect("there");
@@ -811,14 +856,18 @@ mod tests {
             }),
             ("CritterSet::pair_mut", |w, id| {
                 let (a, _) = w.critters.pair_mut(id.index, id.index + 1);
-                a.props.insert("tag".into(), PropValue::Int(7));
+                a.props_mut().insert("tag".into(), PropValue::Int(7));
             }),
             ("CritterSet::iter_mut", |w, _| {
-                w.critters.iter_mut().for_each(|c| c.health += 1.0)
+                w.critters
+                    .iter_mut()
+                    .for_each(|c| c.traits_mut().health += 1.0)
             }),
             ("CritterSet::par_iter_mut", |w, _| {
                 use rayon::prelude::*;
-                w.critters.par_iter_mut().for_each(|c| c.kind.0 ^= 0)
+                w.critters
+                    .par_iter_mut()
+                    .for_each(|c| c.traits_mut().kind.0 ^= 0)
             }),
         ];
         for (name, write) in writes {
@@ -840,6 +889,14 @@ mod tests {
         assert_eq!(after, whole_hash(&mut w), "remove");
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_moving_words_sit_where_the_avx512_load_reads_them() {
+        // Otherwise the fast passes would quietly build the words field by field.
+        assert!(avx512::moving_load::<glam::DVec2>().is_some());
+        assert!(avx512::moving_load::<glam::DVec3>().is_some());
+    }
+
     /// What the debug check is for: a write of a kept field through an accessor that promises
     /// to write only positions and velocities is caught at the next hash.
     #[cfg(debug_assertions)]
@@ -850,15 +907,11 @@ mod tests {
             panic!("gas is 2D")
         };
         w.state_hash();
-        w.critters.slot_mut_moving(0).expect("there").health = -5.0;
+        w.critters
+            .slot_mut_moving(0)
+            .expect("there")
+            .traits_mut()
+            .health = -5.0;
         w.state_hash();
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn the_fields_sit_where_the_avx512_loads_read_them() {
-        // Otherwise the fast pass would quietly fall back to the portable one.
-        assert!(avx512::byte_masks::<glam::DVec2>().is_some());
-        assert!(avx512::byte_masks::<glam::DVec3>().is_some());
     }
 }

@@ -11,9 +11,10 @@
 //! outside (iteration, the state hash, the totals) goes in id order, so where the critters are
 //! stored never shows.
 
-use crate::critter::{Critter, CritterId};
+use crate::critter::{Critter, CritterId, Traits};
 use crate::critter_hash::Statics;
 use crate::vector::Vector;
+use std::sync::Arc;
 
 /// The critters of a world.
 ///
@@ -33,6 +34,9 @@ pub struct CritterSet<V: Vector> {
     place: Vec<u32>,
     live: usize,
     statics: Statics,
+    /// The traits of the critter added last, which the next one shares if it is alike (see
+    /// [`Traits::same_plain`]): a gas spawned from one kind keeps one copy.
+    shared: Option<Arc<Traits<V>>>,
 }
 
 /// In [`CritterSet`]'s table of slots: an id index with no critter.
@@ -91,6 +95,7 @@ impl<V: Vector> Default for CritterSet<V> {
             place: Vec::new(),
             live: 0,
             statics: Statics::default(),
+            shared: None,
         }
     }
 }
@@ -115,7 +120,9 @@ impl<V: Vector> CritterSet<V> {
             index,
             generation: self.generations[index as usize],
         };
-        let critter = Some(make(id));
+        let mut critter = make(id);
+        self.share(&mut critter);
+        let critter = Some(critter);
         if self.place.is_empty() {
             self.slots[index as usize] = critter;
         } else {
@@ -125,6 +132,15 @@ impl<V: Vector> CritterSet<V> {
         }
         self.live += 1;
         id
+    }
+
+    /// Gives `c` the traits of the critter added before it, if the two are alike.
+    fn share(&mut self, c: &mut Critter<V>) {
+        match &self.shared {
+            Some(s) if Arc::ptr_eq(s, &c.traits) => {}
+            Some(s) if s.same_plain(&c.traits) => c.traits = Arc::clone(s),
+            _ => self.shared = Some(Arc::clone(&c.traits)),
+        }
     }
 
     /// Makes room for `additional` more critters than there are slots now, exactly: a scene that
@@ -406,12 +422,14 @@ impl<V: Vector> CritterSet<V> {
             place: Vec::new(),
             live: 0,
             statics: Statics::default(),
+            shared: None,
         };
-        for c in critters {
+        for mut c in critters {
             let i = c.id.index as usize;
             if set.slots[i].is_some() {
                 return None;
             }
+            set.share(&mut c);
             set.generations[i] = c.id.generation;
             set.slots[i] = Some(c);
             set.live += 1;

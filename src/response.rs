@@ -35,7 +35,11 @@ pub fn contact_between<V: Vector>(
     b: &Critter<V>,
 ) -> Option<Contact<V>> {
     let d = topo.delta(a.pos, b.pos);
-    match (&a.shape, &b.shape) {
+    if !a.wall && !b.wall {
+        // Two disks: the shapes (in the traits) need not be read.
+        return contact_ball_ball(d, a.radius, b.radius);
+    }
+    match (a.shape(), b.shape()) {
         (Shape::Disk, Shape::Disk) => contact_ball_ball(d, a.radius, b.radius),
         (Shape::Wall(w), Shape::Disk) => contact_wall_ball(w, d, b.radius),
         (Shape::Disk, Shape::Wall(w)) => contact_wall_ball(w, -d, a.radius).map(|c| Contact {
@@ -78,7 +82,7 @@ pub fn respond<V: Vector>(caller: &mut Critter<V>, arg: &mut Critter<V>, c: &Con
     let vn = (arg.vel - caller.vel).dot(n);
     let mut j = 0.0;
     if vn < 0.0 {
-        let e = caller.restitution.min(arg.restitution);
+        let e = caller.restitution().min(arg.restitution());
         j = -(1.0 + e) * vn / im;
         caller.vel -= n * (j * im1);
         arg.vel += n * (j * im2);

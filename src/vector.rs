@@ -30,7 +30,7 @@ pub trait Vector:
     /// An orthonormal frame, used to orient walls: a unit direction in 2D, a rotation matrix in 3D.
     type Frame: Copy + Debug + PartialEq + Send + Sync;
     /// What aligns a [`crate::critter::Critter`] of this dimension (a zero-length array of it is
-    /// one of its fields): 64 bytes in 2D, so a critter's hot fields share one cache line.
+    /// one of its fields): 64 bytes in 2D, so a critter's record is one cache line.
     type CritterAlign: Clone + Copy + Debug + Send + Sync;
     /// What aligns the event engine's per-critter body (position, velocity, clock, radius: 64
     /// bytes in 3D, so one body is one cache line, never two; 48 in 2D, left unpadded).

@@ -447,7 +447,7 @@ impl Frame {
             }
             f.kind.push(c.kind().0);
             f.id.push(c.id());
-            f.health.push(c.health);
+            f.health.push(c.health());
             f.radius.push(c.radius() as f32);
             f.pos.push(f32x3(c.pos));
             f.vel.push(f32x3(c.vel));

@@ -66,9 +66,9 @@ fn bullet_touching_two_targets_at_once_damages_only_one() {
         "test setup: the bullet touches both"
     );
     // Response order is by id: the bullet meets t1 first, dies, and never meets t2.
-    assert_eq!(world.get(t1).unwrap().health, 2.0);
+    assert_eq!(world.get(t1).unwrap().health(), 2.0);
     assert_eq!(
-        world.get(t2).unwrap().health,
+        world.get(t2).unwrap().health(),
         3.0,
         "a dead bullet damaged a second target"
     );
@@ -332,7 +332,7 @@ fn damage_kills_at_zero_health_and_not_before() {
         .spawn(CritterSpec::ball(DVec2::new(5.9, 5.0)).health(1.0))
         .unwrap();
     world.step().unwrap();
-    assert_eq!(world.get(v).unwrap().health, 0.5);
+    assert_eq!(world.get(v).unwrap().health(), 0.5);
     assert!(world.get(v).unwrap().is_alive());
     assert!(world.events().deaths.is_empty());
     world.step().unwrap();

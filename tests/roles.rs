@@ -440,7 +440,7 @@ fn bullet_damages_a_target_and_dies_without_bouncing_it() {
         .unwrap();
     world.step().unwrap();
     let target = world.get(t).unwrap();
-    assert_eq!(target.health, 2.0);
+    assert_eq!(target.health(), 2.0);
     assert_eq!(target.vel, DVec2::new(0.0, 0.3), "no bounce");
     assert_eq!(
         target.pos,
@@ -487,7 +487,7 @@ fn bullet_collides_normally_with_a_non_target() {
         1e-12,
         "ball pushed",
     );
-    assert_eq!(world.get(o).unwrap().health, 1.0, "no damage");
+    assert_eq!(world.get(o).unwrap().health(), 1.0, "no damage");
 }
 
 #[test]
@@ -540,7 +540,7 @@ fn sensitive_player_takes_damage_from_critters_but_not_from_walls() {
         .unwrap();
     world.step().unwrap();
     assert_eq!(world.events().collisions.len(), 1, "bounced off the wall");
-    assert_eq!(world.get(p).unwrap().health, 5.0, "walls do no damage");
+    assert_eq!(world.get(p).unwrap().health(), 5.0, "walls do no damage");
     assert!(world.get(p).unwrap().vel.y > 0.0);
 
     let b = world
@@ -552,8 +552,12 @@ fn sensitive_player_takes_damage_from_critters_but_not_from_walls() {
         p,
         "the player calls against a critter"
     );
-    assert_eq!(world.get(p).unwrap().health, 4.0, "damaged by the critter");
-    assert_eq!(world.get(b).unwrap().health, 1.0, "the critter is not");
+    assert_eq!(
+        world.get(p).unwrap().health(),
+        4.0,
+        "damaged by the critter"
+    );
+    assert_eq!(world.get(b).unwrap().health(), 1.0, "the critter is not");
 }
 
 #[test]
@@ -590,7 +594,7 @@ fn kind_registered_with_a_parent_is_kind_of_the_parent() {
         .unwrap();
     world.step().unwrap();
     assert_eq!(
-        world.get(a).unwrap().health,
+        world.get(a).unwrap().health(),
         1.0,
         "the armored target took the bullet's damage"
     );

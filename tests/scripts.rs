@@ -117,7 +117,7 @@ fn check_cradle(sets: &[(&str, &str)], speed: f64) {
     let m = w.get(ids[0]).unwrap().mass();
     for &id in &ids {
         assert_eq!(w.get(id).unwrap().mass(), m, "equal masses");
-        assert_eq!(w.get(id).unwrap().restitution, 1.0, "elastic balls");
+        assert_eq!(w.get(id).unwrap().restitution(), 1.0, "elastic balls");
     }
     let steps = scene.default_steps;
     run_with(&mut scene, steps, |_| {});
@@ -244,7 +244,7 @@ fn bullets_vs_player_stops_when_the_damage_adds_up_to_the_players_health() {
         .collect();
     assert_eq!(players.len(), 1, "one free player among the turrets");
     let player = players[0];
-    let health = w.get(player).unwrap().health;
+    let health = w.get(player).unwrap().health();
     assert_eq!(health, 8.0, "the scene gives the player health 8");
     let mut damage = 0.0;
     let mut hits = 0;
@@ -347,7 +347,7 @@ spawn("bullet", #{ pos: vec(9.35, 5), vel: vec(6, 0),
         "the bullet damages its target by its damage, once"
     );
     let t1 = w.get(target).expect("the target survives 3 of 10");
-    assert_eq!(t1.health, t0.health - damage);
+    assert_eq!(t1.health(), t0.health() - damage);
     assert_eq!(t1.vel, t0.vel, "no impulse on the target");
     assert_close_vec(
         t1.pos,
@@ -404,7 +404,7 @@ spawn("bullet", #{ pos: vec(5.35, 5.05), props: #{ tag: "b2", shooter: shooter, 
     let w = w2(&scene);
     for (id, c0) in ids.iter().zip(&before) {
         let c = w.get(*id).expect("all alive");
-        assert_eq!(c.health, c0.health, "{id}: health");
+        assert_eq!(c.health(), c0.health(), "{id}: health");
         assert_eq!(c.pos, c0.pos, "{id}: not pushed");
     }
 }
@@ -549,7 +549,7 @@ spawn("silver_bullet", #{ pos: vec(10.8, 7), vel: vec(4, 0),
         "silver_bullet.rhai's own radius"
     );
     let damage = prop_int(w, to_a, "damage") as f64;
-    let (ha, hb) = (w.get(a).unwrap().health, w.get(b).unwrap().health);
+    let (ha, hb) = (w.get(a).unwrap().health(), w.get(b).unwrap().health());
     let mut bounce = None;
     run_with(&mut scene, 30, |w| {
         for e in &w.events().collisions {
@@ -567,12 +567,12 @@ spawn("silver_bullet", #{ pos: vec(10.8, 7), vel: vec(4, 0),
         "the silver bullet should bounce off the non-target player"
     );
     assert_eq!(
-        w.get(a).unwrap().health,
+        w.get(a).unwrap().health(),
         ha - damage,
         "its one target is hit"
     );
     assert_eq!(
-        w.get(b).unwrap().health,
+        w.get(b).unwrap().health(),
         hb,
         "another armed_player is not hurt"
     );
@@ -618,7 +618,7 @@ spawn("ball", #{ pos: vec(5, 8), vel: vec(0, -1), props: #{ tag: "ball2" } });
 "#,
     );
     let player = tagged(w2(&scene), "player");
-    let h0 = w2(&scene).get(player).unwrap().health;
+    let h0 = w2(&scene).get(player).unwrap().health();
     let (mut wall_hits, mut ball_hits, mut taken) = (0, 0, 0.0);
     run_with(&mut scene, 300, |w| {
         let n = w.step_count();
@@ -649,7 +649,7 @@ spawn("ball", #{ pos: vec(5, 8), vel: vec(0, -1), props: #{ tag: "ball2" } });
             "step {n}: 1 per ball hit, none per wall hit"
         );
         taken += damage.iter().sum::<f64>();
-        assert_eq!(w.get(player).unwrap().health, h0 - taken, "step {n}");
+        assert_eq!(w.get(player).unwrap().health(), h0 - taken, "step {n}");
     });
     assert!(wall_hits > 0, "the player should have hit a wall");
     assert!(ball_hits > 0, "a ball should have hit the player");
@@ -672,7 +672,7 @@ spawn("ball", #{ pos: vec(3.5, 5), vel: vec(3, 0) });
         assert!(w.events().damages.is_empty());
     });
     assert!(hits > 0, "the ball should have hit the player");
-    assert_eq!(w2(&scene).get(player).unwrap().health, 3.0);
+    assert_eq!(w2(&scene).get(player).unwrap().health(), 3.0);
 }
 
 #[test]
@@ -707,7 +707,7 @@ spawn("ball", #{ pos: vec(12, 5) });
             died_at = Some(n);
         } else {
             let c = w.get(player).expect("alive while health > 0");
-            assert_eq!(c.health, health, "step {n}");
+            assert_eq!(c.health(), health, "step {n}");
         }
     });
     assert!(
@@ -1020,8 +1020,8 @@ spawn("tracer", #{ pos: vec(10.5, 5), vel: vec(6, 0),
         PropValue::List(vec![PropValue::Text("armed_player".into())])
     );
     assert_eq!(prop_int(w, tracer, "damage"), 5, "its own default wins");
-    let h_shooter = w.get(shooter).unwrap().health;
-    let h_target = w.get(target).unwrap().health;
+    let h_shooter = w.get(shooter).unwrap().health();
+    let h_target = w.get(target).unwrap().health();
 
     run_with(&mut scene, 30, |w| {
         for e in &w.events().collisions {
@@ -1031,9 +1031,9 @@ spawn("tracer", #{ pos: vec(10.5, 5), vel: vec(6, 0),
     });
     let w = w2(&scene);
     assert!(w.get(tracer).is_none(), "the inherited collide kills it");
-    assert_eq!(w.get(target).unwrap().health, h_target - 5.0);
+    assert_eq!(w.get(target).unwrap().health(), h_target - 5.0);
     assert_eq!(
-        w.get(shooter).unwrap().health,
+        w.get(shooter).unwrap().health(),
         h_shooter,
         "never its shooter"
     );

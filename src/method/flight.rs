@@ -670,7 +670,7 @@ fn fly<V: Vector>(
                 c.pos = if topo.wraps() {
                     topo.wrap_position(c.pos)
                 } else {
-                    topo.apply(c.pos, c.vel, c.radius, c.restitution).0
+                    topo.apply(c.pos, c.vel, c.radius, c.restitution()).0
                 };
             }
         }
@@ -895,7 +895,7 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, span: f64, ho
         if !c.alive {
             continue;
         }
-        match &c.shape {
+        match &c.shape() {
             Shape::Disk => {
                 let k = sc.cell[c.id.index as usize] as usize;
                 sc.cells.push(k, c.id.index);
@@ -999,7 +999,7 @@ fn near_a_wall<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, mine: f64) -> b
             let Some(c) = w.critters.slot(x) else {
                 continue;
             };
-            let Shape::Wall(wall) = &c.shape else {
+            let Shape::Wall(wall) = &c.shape() else {
                 continue;
             };
             let d = w.topo.delta(c.pos, body.pos);
@@ -1802,7 +1802,7 @@ fn predict_pair_or_wall<V: Vector>(
         let Some(cb) = w.critters.slot(b) else {
             return Ok(());
         };
-        let Shape::Wall(wall) = &cb.shape else {
+        let Shape::Wall(wall) = &cb.shape() else {
             return Ok(());
         };
         let d = w.topo.delta(cb.pos, pa);
@@ -1996,7 +1996,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
     let outward = if side == 1 { v > 0.0 } else { v < 0.0 };
     if outward {
         match border {
-            Border::Bounce => c.vel.set(axis, -c.restitution * v),
+            Border::Bounce => c.vel.set(axis, -c.restitution() * v),
             _ => c.vel.set(axis, 0.0),
         }
     }
@@ -2184,10 +2184,10 @@ fn collide<V: Vector>(
     let recent = |x: u32| t - sc.last_t[x as usize] < sc.tc;
     let tc = recent(a) || (!cb.is_wall() && recent(b));
     let saved = if tc {
-        let e = [a, b].map(|x| w.critters.slot(x).map_or(1.0, |c| c.restitution));
+        let e = [a, b].map(|x| w.critters.slot(x).map_or(1.0, |c| c.restitution()));
         for x in [a, b] {
             if let Some(c) = w.critters.slot_mut(x) {
-                c.restitution = 1.0;
+                c.traits_mut().restitution = 1.0;
             }
         }
         Some(e)
@@ -2199,8 +2199,8 @@ fn collide<V: Vector>(
     if let Some(e) = saved {
         for (x, e) in [a, b].into_iter().zip(e) {
             if let Some(c) = w.critters.slot_mut(x) {
-                if c.restitution == 1.0 {
-                    c.restitution = e;
+                if c.restitution() == 1.0 {
+                    c.traits_mut().restitution = e;
                 }
             }
         }
@@ -2537,7 +2537,7 @@ mod tests {
     fn shells_conserve_energy_and_momentum_and_leave_no_overlap() {
         let mut w = periodic_gas(false);
         let e0 = w.kinetic_energy();
-        let p0: DVec3 = w.critters().iter().map(|c| c.vel * c.mass).sum();
+        let p0: DVec3 = w.critters().iter().map(|c| c.vel * c.mass()).sum();
         let mut impacts = 0;
         for _ in 0..6 {
             w.step().expect("steps");
@@ -2545,7 +2545,7 @@ mod tests {
         }
         assert!(impacts > 5 * 512, "{impacts} collisions");
         let e1 = w.kinetic_energy();
-        let p1: DVec3 = w.critters().iter().map(|c| c.vel * c.mass).sum();
+        let p1: DVec3 = w.critters().iter().map(|c| c.vel * c.mass()).sum();
         assert!(((e1 - e0) / e0).abs() < 1e-12, "energy {e0} -> {e1}");
         assert!(
             (p1 - p0).length() < 1e-9 * e0.sqrt(),

@@ -254,7 +254,7 @@ impl<V: Vector> World<V> {
                 continue; // two fixed critters: nothing can move
             }
             let v0 = (bb.vel - ba.vel).dot(c.normal);
-            let e = ca.restitution.min(cb.restitution);
+            let e = ca.restitution().min(cb.restitution());
             let scale = match (ca.is_wall(), cb.is_wall()) {
                 (true, _) => cb.radius,
                 (_, true) => ca.radius,
@@ -455,7 +455,7 @@ impl<V: Vector> World<V> {
     fn own_collide(&self, slot: u32) -> bool {
         self.critters
             .slot(slot)
-            .is_some_and(|c| self.kinds.get(c.kind).has_collide)
+            .is_some_and(|c| self.kinds.get(c.kind()).has_collide)
     }
 }
 

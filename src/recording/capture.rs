@@ -124,13 +124,13 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
         }
         s.radius.0.push(c.radius());
         s.mass.0.push(c.mass());
-        s.health.0.push(c.health);
-        s.restitution.0.push(c.restitution);
+        s.health.0.push(c.health());
+        s.restitution.0.push(c.restitution());
         s.priority.0.push(c.priority());
         s.fixed.push(c.is_fixed());
         s.alive.push(c.is_alive());
-        if !c.props.is_empty() {
-            s.props.insert(id.to_string(), c.props.clone());
+        if !c.props().is_empty() {
+            s.props.insert(id.to_string(), c.props().clone());
         }
         if let Some(w) = c.wall() {
             let v = |x: V| Floats((0..V::DIM).map(|a| x.get(a)).collect());

@@ -12,11 +12,12 @@ use super::compare::first_difference;
 use super::reader::{self, Recording};
 use super::rebuild::{rebuild, Rebuilt};
 use super::schema::{id_of, StateMsg};
-use crate::critter::{Critter, CritterId, Shape, CLASS_UNSET};
+use crate::critter::{Critter, CritterId, Shape, Traits, CLASS_UNSET};
 use crate::kind::KindId;
 use crate::scenes::AnyWorld;
 use crate::vector::Vector;
 use crate::world::World;
+use std::sync::Arc;
 
 /// Why a replay could not reach a step.
 #[derive(Debug, thiserror::Error)]
@@ -189,25 +190,27 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
         let (mass, fixed) = (s.mass.0[i], s.fixed[i]);
         critters.push(Critter {
             id,
-            kind,
             class: CLASS_UNSET,
             pos,
             vel,
             radius: s.radius.0[i],
-            mass,
             _align: [],
-            priority: s.priority.0[i],
-            restitution: s.restitution.0[i],
-            health: s.health.0[i],
             fixed,
             alive: s.alive[i],
             wall: false,
-            shape: Shape::Disk,
-            props: s
-                .props
-                .get(&s.id[i].to_string())
-                .cloned()
-                .unwrap_or_default(),
+            traits: Arc::new(Traits {
+                kind,
+                mass,
+                priority: s.priority.0[i],
+                restitution: s.restitution.0[i],
+                health: s.health.0[i],
+                shape: Shape::Disk,
+                props: s
+                    .props
+                    .get(&s.id[i].to_string())
+                    .cloned()
+                    .unwrap_or_default(),
+            }),
         });
     }
     w.restore(s.step, rng, critters, &free)?;

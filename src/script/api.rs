@@ -410,8 +410,8 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
             None => return Err(gone(id)),
         };
         match env.critter_mut(id) {
-            Some(c) if create || c.props.contains_key(name) => {
-                c.props.insert(name.to_string(), prop);
+            Some(c) if create || c.props().contains_key(name) => {
+                c.props_mut().insert(name.to_string(), prop);
                 Ok(())
             }
             Some(_) => fail_hint(
@@ -466,8 +466,8 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
     critter_field!(engine, host, "vel", |c| to_svec(c.vel));
     critter_field!(engine, host, "radius", |c| c.radius());
     critter_field!(engine, host, "mass", |c| c.mass());
-    critter_field!(engine, host, "health", |c| c.health);
-    critter_field!(engine, host, "restitution", |c| c.restitution);
+    critter_field!(engine, host, "health", |c| c.health());
+    critter_field!(engine, host, "restitution", |c| c.restitution());
     critter_field!(engine, host, "priority", |c| c.priority());
     critter_field!(engine, host, "fixed", |c| c.is_fixed());
     critter_field!(engine, host, "is_wall", |c| c.is_wall());
@@ -510,14 +510,14 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
         Ok(())
     });
     critter_setter!(engine, host, "health", Dynamic, |c, v| set_num(
-        &mut c.health,
+        &mut c.traits_mut().health,
         &v,
         "health",
         f64::is_finite,
         "must be a finite number"
     ));
     critter_setter!(engine, host, "restitution", Dynamic, |c, v| set_num(
-        &mut c.restitution,
+        &mut c.traits_mut().restitution,
         &v,
         "restitution",
         |e| (0.0..=1.0).contains(&e),
@@ -529,7 +529,7 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_indexer_get(move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {
         let id = r.0;
         with_env!(h, env => match env.critter(id) {
-            Some(c) => match c.props.get(name) {
+            Some(c) => match c.props().get(name) {
                 Some(p) => Ok(from_prop(p)),
                 None => fail(format!(
                     "critter {id} ({}) has no property '{name}'; give it one in its kind's props or spawn map, or test with has(\"{name}\")",
@@ -559,7 +559,7 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_get("tag", move |r: &mut CritterRef| -> Res<Dynamic> {
         let id = r.0;
         with_env!(h, env => match env.critter(id) {
-            Some(c) => c.props.get("tag").map_or_else(
+            Some(c) => c.props().get("tag").map_or_else(
                 || fail(format!("critter {id} has no property 'tag'")),
                 |p| Ok(from_prop(p)),
             ),
@@ -576,7 +576,7 @@ fn register_critter(engine: &mut Engine, host: &Rc<Host>) {
     let h = host.clone();
     engine.register_fn("has", move |r: &mut CritterRef, name: &str| -> Res<bool> {
         let id = r.0;
-        with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.props.contains_key(name))))
+        with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.props().contains_key(name))))
     });
 
     let h = host.clone();

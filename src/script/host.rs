@@ -89,8 +89,8 @@ impl<V: Vector> Env<V> for World<V> {
     fn damage(&mut self, id: CritterId, amount: f64) {
         let dead = match self.get_mut(id) {
             Some(c) => {
-                c.health -= amount;
-                c.health <= 0.0
+                c.traits_mut().health -= amount;
+                c.health() <= 0.0
             }
             None => false,
         };

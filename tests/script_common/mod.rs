@@ -137,7 +137,7 @@ pub fn tagged(w: &World<DVec2>, tag: &str) -> CritterId {
     let found: Vec<CritterId> = w
         .critters()
         .iter()
-        .filter(|c| c.props.get("tag") == Some(&PropValue::Text(tag.to_string())))
+        .filter(|c| c.props().get("tag") == Some(&PropValue::Text(tag.to_string())))
         .map(|c| c.id())
         .collect();
     assert_eq!(
@@ -159,7 +159,7 @@ pub fn prop(w: &World<DVec2>, id: CritterId, name: &str) -> PropValue {
     let c = w
         .get(id)
         .unwrap_or_else(|| panic!("critter {id} should be alive"));
-    c.props
+    c.props()
         .get(name)
         .cloned()
         .unwrap_or_else(|| panic!("critter {id} should have a property '{name}'"))
