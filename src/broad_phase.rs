@@ -1095,10 +1095,11 @@ fn overlap_flag<V: Vector>(topo: &Topology<V>, a: &BroadObject<V>, b: &BroadObje
 /// (8: the list's builds at a million critters about 2 % faster than with 4; no change at 1e4).
 const MEMBERS_AHEAD: usize = 8;
 
-/// How many pairs ahead [`retest`] asks for its objects to be prefetched (16: the re-test at a
-/// million critters about 7 % faster than with 8, where a load from memory outlasts 8 pair
-/// tests; no change at 1e4, docs/performance.md).
-const PAIRS_AHEAD: usize = 16;
+/// How many pairs ahead [`retest`] asks for its objects to be prefetched (64: with 64-byte 2D
+/// records the broad phase at a million critters took 12.2 ms a step on two threads against
+/// 12.7-13.2 with 32 and 14.1-14.3 with 16, and 17.8-18.5 on one thread against 18.9-19.7 and
+/// 20.7-21.2; no change at 1e3 to 1e5. With 128-byte records, 16 had been 7 % faster than 8).
+const PAIRS_AHEAD: usize = 64;
 
 /// The pairs of `pairs` (indices) whose exact boxes overlap, by slot, pushed onto `out`. The
 /// objects of the pair [`PAIRS_AHEAD`] places on are asked for while this one is tested: the
