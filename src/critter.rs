@@ -106,9 +106,10 @@ pub(crate) const CLASS_UNSET: u32 = u32::MAX;
 /// The record holds what the passes over every critter read (the move, the broad phase's
 /// re-test, the narrow phase): position, velocity, radius, id, rule class, fixed, alive and the
 /// wall flag, laid out by hand (`repr(C)`). In 2D it is 64 bytes aligned to 64, one cache line;
-/// 80 bytes in 3D. The rest, [`Traits`], sits behind a shared pointer: critters alike (a gas
-/// spawned from one kind) share one copy, and a change makes the changed critter its own (see
-/// [`Critter::traits_mut`]). A pass over a million 2D critters then streams 64 MB, not 128.
+/// 80 bytes in 3D. The rest, the traits (kind, mass, priority, restitution, health, shape,
+/// properties), sits behind a shared pointer: critters alike (a gas spawned from one kind) share
+/// one copy, and a setter makes the changed critter's copy its own first. A pass over a million
+/// 2D critters then streams 64 MB, not 128.
 #[derive(Clone, Debug)]
 #[repr(C)]
 pub struct Critter<V: Vector> {

@@ -2390,7 +2390,8 @@ mod layout_tests {
     use super::*;
     use glam::DVec2;
 
-    fn gas(n: usize) -> World<DVec2> {
+    /// The built-in gas of `n` disks.
+    pub(super) fn gas(n: usize) -> World<DVec2> {
         let params = crate::scenes::SceneParams {
             n: Some(n),
             ..Default::default()
@@ -2538,24 +2539,11 @@ mod layout_tests {
 
 #[cfg(test)]
 mod traits_tests {
+    use super::layout_tests::gas;
     use super::*;
     use crate::critter::PropValue;
     use glam::DVec2;
     use std::sync::Arc;
-
-    fn gas(n: usize) -> World<DVec2> {
-        let params = crate::scenes::SceneParams {
-            n: Some(n),
-            ..Default::default()
-        };
-        match crate::scenes::builtin("gas", &params)
-            .expect("builds")
-            .world
-        {
-            crate::scenes::AnyWorld::D2(w) => w,
-            crate::scenes::AnyWorld::D3(_) => panic!("gas is 2D"),
-        }
-    }
 
     fn disks(w: &World<DVec2>) -> Vec<&Critter<DVec2>> {
         w.critters().iter().filter(|c| !c.is_wall()).collect()
