@@ -875,7 +875,7 @@ impl<V: Vector> World<V> {
             let Some(wall) = self.critters.get(wall_id) else {
                 continue;
             };
-            let Shape::Wall(geom) = &wall.shape() else {
+            let Shape::Wall(geom) = wall.shape() else {
                 continue;
             };
             let d = self.topo.delta(wall.pos, spec.pos);
@@ -2068,7 +2068,7 @@ pub(crate) fn prefetch_whole<T>(slot: Option<&T>) {
 /// A wall's box half sizes.
 #[inline]
 fn wall_half<V: Vector>(c: &Critter<V>) -> V {
-    match &c.shape() {
+    match c.shape() {
         Shape::Wall(w) => w.aabb_half(),
         Shape::Disk => V::splat(c.radius),
     }

@@ -895,7 +895,7 @@ fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, span: f64, ho
         if !c.alive {
             continue;
         }
-        match &c.shape() {
+        match c.shape() {
             Shape::Disk => {
                 let k = sc.cell[c.id.index as usize] as usize;
                 sc.cells.push(k, c.id.index);
@@ -999,7 +999,7 @@ fn near_a_wall<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, mine: f64) -> b
             let Some(c) = w.critters.slot(x) else {
                 continue;
             };
-            let Shape::Wall(wall) = &c.shape() else {
+            let Shape::Wall(wall) = c.shape() else {
                 continue;
             };
             let d = w.topo.delta(c.pos, body.pos);
@@ -1802,7 +1802,7 @@ fn predict_pair_or_wall<V: Vector>(
         let Some(cb) = w.critters.slot(b) else {
             return Ok(());
         };
-        let Shape::Wall(wall) = &cb.shape() else {
+        let Shape::Wall(wall) = cb.shape() else {
             return Ok(());
         };
         let d = w.topo.delta(cb.pos, pa);
