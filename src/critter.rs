@@ -273,14 +273,7 @@ impl<V: Vector> Critter<V> {
     }
     /// Sets the coefficient of restitution (in [0, 1]).
     pub fn set_restitution(&mut self, restitution: f64) -> Result<(), crate::Error> {
-        if !(0.0..=1.0).contains(&restitution) {
-            return Err(crate::Error::InvalidCritter {
-                critter: self.describe(),
-                field: "restitution",
-                value: restitution.to_string(),
-                reason: "must be between 0 (sticky) and 1 (elastic)".into(),
-            });
-        }
+        check_restitution(|| self.describe(), restitution)?;
         self.traits_mut().restitution = restitution;
         Ok(())
     }
@@ -324,6 +317,23 @@ pub(crate) fn check_positive(
             field,
             value: v.to_string(),
             reason: "must be a finite number greater than zero".into(),
+        })
+    }
+}
+
+/// A coefficient of restitution must lie in [0, 1].
+pub(crate) fn check_restitution(
+    critter: impl FnOnce() -> String,
+    e: f64,
+) -> Result<(), crate::Error> {
+    if (0.0..=1.0).contains(&e) {
+        Ok(())
+    } else {
+        Err(crate::Error::InvalidCritter {
+            critter: critter(),
+            field: "restitution",
+            value: e.to_string(),
+            reason: "must be between 0 (sticky) and 1 (elastic)".into(),
         })
     }
 }

@@ -20,7 +20,8 @@ use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode, Escapes, Objec
 use crate::contact::contact_wall_ball;
 use crate::context::{Access, CollideCtx, Pending, StepEvents, UpdateCtx};
 use crate::critter::{
-    check_positive, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET, CP_WALL,
+    check_positive, check_restitution, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET,
+    CP_WALL,
 };
 use crate::critter_set::CritterSet;
 use crate::error::Error;
@@ -845,14 +846,7 @@ impl<V: Vector> World<V> {
         let mass = mass.unwrap_or(density * radius * radius * radius);
         check_positive(who, "mass", mass)?;
         let restitution = spec.restitution.unwrap_or(d.restitution);
-        if !(0.0..=1.0).contains(&restitution) {
-            return Err(Error::InvalidCritter {
-                critter: who(),
-                field: "restitution",
-                value: restitution.to_string(),
-                reason: "must be between 0 (sticky) and 1 (elastic)".into(),
-            });
-        }
+        check_restitution(who, restitution)?;
         let priority = spec.priority.unwrap_or(d.priority);
         if !priority.is_finite() {
             return Err(Error::InvalidCritter {
