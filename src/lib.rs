@@ -24,7 +24,6 @@
 
 pub mod border;
 pub mod broad_phase;
-pub mod cli;
 pub mod contact;
 pub mod context;
 pub mod critter;

@@ -45,6 +45,11 @@ impl AnyWorld {
     pub fn step_count(&self) -> u64 {
         both!(self, w => w.step_count())
     }
+
+    /// The seed of the world's random generator.
+    pub fn seed(&self) -> u64 {
+        both!(self, w => w.seed())
+    }
     /// The collision method.
     pub fn method(&self) -> crate::method::Method {
         both!(self, w => w.method())

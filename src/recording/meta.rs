@@ -3,7 +3,9 @@
 //! MCAP metadata maps strings to strings; structured values are JSON text, floats are written
 //! in their shortest round-trip form so they read back bit for bit.
 
+use super::keyframes::default_record_every;
 use super::schema::{FORMAT, STATE_HASH};
+use crate::scenes::Scene;
 use crate::script::Limits;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -66,6 +68,61 @@ pub struct RunMeta {
     pub critters: usize,
     /// When the recording was made (UTC, informational).
     pub created: String,
+}
+
+/// What a run changes of its scene's own settings (the command line's `--seed`, `--dt`, `-n`,
+/// `--set`, `--steps`, the script limits and `--record-every`), as its recording keeps them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunOverrides {
+    /// `--seed`.
+    pub seed: Option<u64>,
+    /// `--dt`.
+    pub dt: Option<f64>,
+    /// `-n` (built-in scenes).
+    pub n: Option<usize>,
+    /// `--set NAME=VALUE`, already applied to the scene.
+    pub sets: Vec<String>,
+    /// `--steps` (default: the scene's own).
+    pub steps: Option<u64>,
+    /// The script limits the scene runs under.
+    pub limits: Limits,
+    /// `--record-every` (default: [`default_record_every`] of the scene's size).
+    pub record_every: Option<u64>,
+}
+
+impl RunMeta {
+    /// How `scene` is run with `overrides`: what a recording of the run starts with.
+    pub fn for_scene(scene: &Scene, overrides: &RunOverrides) -> RunMeta {
+        let world = &scene.world;
+        let source = match scene.sources.first() {
+            Some(file) => SceneSource::Script {
+                file: file.path.clone(),
+            },
+            None => SceneSource::Builtin,
+        };
+        RunMeta {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.name.clone(),
+            source,
+            seed: world.seed(),
+            seed_override: overrides.seed,
+            dt: world.dt(),
+            dt_override: overrides.dt,
+            steps: overrides.steps.unwrap_or(scene.default_steps),
+            method: world.method().to_string(),
+            dim: world.dim(),
+            border: format!("{:?}", world.border()).to_lowercase(),
+            n: overrides.n,
+            sets: overrides.sets.clone(),
+            limits: overrides.limits.clone(),
+            command_line: std::env::args().collect(),
+            record_every: overrides
+                .record_every
+                .unwrap_or_else(|| default_record_every(world.len())),
+            critters: world.len(),
+            created: utc_now().1,
+        }
+    }
 }
 
 fn float(x: f64) -> String {

@@ -22,7 +22,6 @@ pub mod foxglove;
 pub mod keyframes;
 pub mod meta;
 pub mod path;
-pub mod plot;
 pub mod reader;
 pub mod rebuild;
 pub mod recover;
@@ -31,6 +30,6 @@ pub mod schema;
 pub mod verify;
 pub mod writer;
 
-pub use meta::{EndMeta, RunMeta, SceneSource};
+pub use meta::{EndMeta, RunMeta, RunOverrides, SceneSource};
 pub use reader::Recording;
 pub use writer::{Recorder, Written};

@@ -7,6 +7,7 @@ use super::errors::eval_error;
 use super::host::{with_env, Host};
 use super::{Runtime, ScriptOptions};
 use crate::error::{Error, ScriptError};
+use crate::recording::{RunMeta, RunOverrides};
 use crate::scenes::AnyWorld;
 use glam::DVec3;
 use rhai::{Dynamic, Engine, FnPtr, Map, NativeCallContext, Scope, INT};
@@ -354,12 +355,11 @@ fn start_recording(host: &Host) -> Res<()> {
     };
     let limits = runner_limits(host)?;
     let rec = with_scene(host, |scene| {
-        let mut meta = crate::cli::record::run_meta(
-            &crate::cli::run::RunArgs::default(),
-            scene,
-            scene.default_steps,
-        );
-        meta.limits = limits.clone();
+        let overrides = RunOverrides {
+            limits: limits.clone(),
+            ..RunOverrides::default()
+        };
+        let mut meta = RunMeta::for_scene(scene, &overrides);
         if scene.sources.is_empty() {
             // Built by the test function itself: no scene to rebuild it from.
             meta.source = crate::recording::SceneSource::Test { case: case.clone() };
@@ -408,11 +408,14 @@ fn expect_matches_recording(host: &Host, path: &str) -> Res<()> {
         let steps = with_scene(host, |s| s.default_steps)?;
         let limits = runner_limits(host)?;
         let rec = with_scene(host, |scene| {
-            let mut meta =
-                crate::cli::record::run_meta(&crate::cli::run::RunArgs::default(), scene, steps);
-            meta.limits = limits.clone();
-            // Only the hashes are compared: full states at the start and the end keep it small.
-            meta.record_every = steps.max(1);
+            let overrides = RunOverrides {
+                steps: Some(steps),
+                limits: limits.clone(),
+                // Only the hashes are compared: full states at the start and the end keep it small.
+                record_every: Some(steps.max(1)),
+                ..RunOverrides::default()
+            };
+            let meta = RunMeta::for_scene(scene, &overrides);
             crate::recording::Recorder::create(&file, &meta, &scene.sources, &scene.world)
         })?;
         let mut rec = rec.map_or_else(

@@ -11,7 +11,8 @@ use critterbox::recording::{capture, Recording};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+/// The repository, where the scripts and recordings are.
+const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
 /// A fresh folder for one test.
 fn tmp(name: &str) -> PathBuf {
@@ -676,7 +677,7 @@ fn run_records_by_default_under_the_recordings_folder() {
 fn inspect_counts_the_deaths_of_a_run_with_deaths() {
     let dir = tmp("inspect_deaths");
     let file = dir.join("bullets.mcap");
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/bullets_vs_player.rhai");
+    let scene = Path::new(ROOT).join("scripts/scenes/bullets_vs_player.rhai");
     record(&file, &[scene.to_str().unwrap(), "--steps", "400"]);
     let rec = Recording::open(&file).expect("opens");
     let recorded: usize = rec.lifecycle.iter().map(|l| l.die.len()).sum();
@@ -711,7 +712,7 @@ fn inspect_counts_the_deaths_of_a_run_with_deaths() {
 fn a_step_is_replayed_from_the_keyframe_before_it_exactly() {
     let dir = tmp("restore");
     let (all, sparse) = (dir.join("every1.mcap"), dir.join("every40.mcap"));
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/bullets_vs_player.rhai");
+    let scene = Path::new(ROOT).join("scripts/scenes/bullets_vs_player.rhai");
     let scene = scene.to_str().unwrap();
     record(&all, &[scene, "--record-every", "1"]);
     record(&sparse, &[scene, "--record-every", "40"]);
@@ -810,7 +811,7 @@ fn a_kind_loaded_mid_run_survives_a_killed_run() {
     use std::time::{Duration, Instant};
     let dir = tmp("late_kind_killed");
     let file = dir.join("late.mcap");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(ROOT);
     let mut child = Command::new(env!("CARGO_BIN_EXE_critterbox"))
         .args(["run", "tests/scenes/late_kind.rhai", "--steps", "100000000"])
         .args(["--record-every", "500", "--record", file.to_str().unwrap()])
@@ -866,7 +867,7 @@ fn a_kind_loaded_mid_run_survives_a_killed_run() {
 fn a_solve_run_is_replayed_from_its_keyframes_with_its_contact_impulses() {
     let dir = tmp("restore_solve");
     let (all, sparse) = (dir.join("every1.mcap"), dir.join("every25.mcap"));
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/pile.rhai");
+    let scene = Path::new(ROOT).join("scripts/scenes/pile.rhai");
     let args = [
         scene.to_str().unwrap(),
         "--method",
@@ -950,7 +951,7 @@ fn replayed_from_keyframes_as_recorded(all: &Path, sparse: &Recording, steps: &[
 fn a_sleeping_pile_is_replayed_from_its_keyframes_with_its_quiet_steps() {
     let dir = tmp("restore_sleep");
     let (all, sparse) = (dir.join("every1.mcap"), dir.join("every40.mcap"));
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes/pile.rhai");
+    let scene = Path::new(ROOT).join("scripts/scenes/pile.rhai");
     let args = [scene.to_str().unwrap(), "--steps", "600"];
     record(&all, &[&args[..], &["--record-every", "1"]].concat());
     record(&sparse, &[&args[..], &["--record-every", "40"]].concat());

@@ -1,10 +1,10 @@
 //! `critterbox run`: run a scene headless and print a summary.
 
 use super::record::{self, RecordArgs};
-use crate::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
-use crate::script::{Limits, ScriptOptions};
 use anyhow::Context;
 use clap::Args;
+use critterbox::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
+use critterbox::script::{Limits, ScriptOptions};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -53,7 +53,7 @@ pub struct RunArgs {
     pub n: Option<usize>,
     /// Collision method: discrete, substep:N, swept, event, solve:N or auto (default: the scene's own).
     #[arg(long, value_parser = parse_method)]
-    pub method: Option<crate::method::Method>,
+    pub method: Option<critterbox::method::Method>,
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
@@ -170,7 +170,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out, "auto chose   {chose} (last step): {why}")?;
     }
     let stepped = scene.world.auto_choice().map_or(method, |c| c.0);
-    if matches!(stepped, crate::method::Method::Solve(_)) {
+    if matches!(stepped, critterbox::method::Method::Solve(_)) {
         let how = if scene.world.sleep_allowed() {
             "critters at rest under gravity sleep; `sleep: false` in world(#{ ... }) turns it off"
         } else {
@@ -246,14 +246,14 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         seed: args.seed,
         ..ScriptOptions::default()
     };
-    Ok(crate::script::load_scene(
+    Ok(critterbox::script::load_scene(
         std::path::Path::new(name),
         &sets,
         &options,
     )?)
 }
 
-fn parse_method(s: &str) -> Result<crate::method::Method, String> {
+fn parse_method(s: &str) -> Result<critterbox::method::Method, String> {
     s.parse()
 }
 

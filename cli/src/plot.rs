@@ -1,6 +1,6 @@
 //! `inspect --plot`: kinetic energy, momentum and collisions over the steps, as SVG or PNG.
 
-use super::reader::Recording;
+use critterbox::recording::Recording;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -1,11 +1,11 @@
 //! `critterbox stability`: run the stress scenes under every method and print the table of
 //! `docs/stability.md` (scene x method -> measured error), in 2D and in 3D.
 
-use crate::method::Method;
-use crate::stability::{
+use clap::Args;
+use critterbox::method::Method;
+use critterbox::stability::{
     first_tunnelling_speed, first_tunnelling_speed_3d, Stress, METHODS, STRESS, STRESS_3D,
 };
-use clap::Args;
 use std::io::Write;
 use std::time::Instant;
 
@@ -34,7 +34,7 @@ pub fn run(_args: &StabilityArgs, out: &mut dyn Write) -> anyhow::Result<()> {
 fn table(
     out: &mut dyn Write,
     bullet: &str,
-    first_tunnelling: fn(Method) -> Result<Option<f64>, crate::error::Error>,
+    first_tunnelling: fn(Method) -> Result<Option<f64>, critterbox::error::Error>,
     scenes: &[Stress],
 ) -> anyhow::Result<()> {
     let header: Vec<String> = METHODS.iter().map(|m| m.to_string()).collect();

@@ -1,7 +1,7 @@
 //! `critterbox check FILE...`: compile and validate scripts without running them.
 
-use crate::script::{check, ScriptOptions};
 use clap::Args;
+use critterbox::script::{check, ScriptOptions};
 use std::io::Write;
 use std::path::PathBuf;
 

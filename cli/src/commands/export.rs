@@ -1,8 +1,8 @@
 //! `critterbox export FILE --csv DIR`: a recording's states and events as CSV files.
 
-use crate::recording::export::export_csv;
-use crate::recording::Recording;
 use clap::Args;
+use critterbox::recording::export::export_csv;
+use critterbox::recording::Recording;
 use std::io::Write;
 use std::path::PathBuf;
 

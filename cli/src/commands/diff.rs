@@ -1,10 +1,10 @@
 //! `critterbox diff A B`: the first step and critter where two recordings differ.
 
-use crate::recording::compare::first_difference;
-use crate::recording::reader::state_at;
-use crate::recording::replay::state_at_step;
-use crate::recording::Recording;
 use clap::Args;
+use critterbox::recording::compare::first_difference;
+use critterbox::recording::reader::state_at;
+use critterbox::recording::replay::state_at_step;
+use critterbox::recording::Recording;
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -18,7 +18,7 @@ fn write(dir: &Path, name: &str, text: &str) {
 fn critterbox(args: &[&str]) -> (Option<i32>, String, String) {
     let o = Command::new(env!("CARGO_BIN_EXE_critterbox"))
         .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
         .output()
         .expect("critterbox runs");
     (
@@ -28,8 +28,9 @@ fn critterbox(args: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
-fn suite() -> PathBuf {
-    let dir = temp_dir("suite");
+/// The suite in a folder of the calling test's own (tests may share a process).
+fn suite(test: &str) -> PathBuf {
+    let dir = temp_dir(&format!("suite-{test}"));
     write(
         &dir,
         "good.rhai",
@@ -81,7 +82,7 @@ fn test_loops_forever() {
 
 #[test]
 fn failures_name_file_and_line_and_the_rest_still_run() {
-    let dir = suite();
+    let dir = suite("failures");
     let junit = dir.join("junit.xml");
     let runs = dir.join("runs");
     let (code, out, _err) = critterbox(&[
@@ -149,7 +150,7 @@ fn failures_name_file_and_line_and_the_rest_still_run() {
 
 #[test]
 fn filter_runs_only_matching_tests_and_all_passing_exits_zero() {
-    let dir = suite();
+    let dir = suite("filter");
     let (code, out, _) = critterbox(&[
         "test",
         dir.to_str().expect("utf-8"),

@@ -4,10 +4,10 @@
 //! (see the README for how to read it). Text is laid out
 //! with a TrueType font (`--font`), for both files.
 
-use crate::method::Method;
-use crate::stability::{chart_pile_points, chart_points, ChartPoint};
 use anyhow::Context;
 use clap::Args;
+use critterbox::method::Method;
+use critterbox::stability::{chart_pile_points, chart_points, ChartPoint};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::io::Write;

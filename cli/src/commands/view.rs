@@ -1,8 +1,8 @@
 //! The `--rerun*` options shared by `run` (and `replay`): a viewer when the `rerun` feature is
 //! built in, a clear error otherwise.
 
-use crate::scenes::AnyWorld;
 use clap::Args;
+use critterbox::scenes::AnyWorld;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -33,7 +33,7 @@ impl ViewArgs {
 /// A viewer, or nothing.
 pub struct Viewer {
     #[cfg(feature = "rerun")]
-    sink: Option<crate::viewer::RerunSink>,
+    sink: Option<critterbox::viewer::RerunSink>,
 }
 
 impl Viewer {
@@ -55,7 +55,7 @@ impl Viewer {
         }
         #[cfg(feature = "rerun")]
         {
-            use crate::viewer::{RerunSink, RerunTarget};
+            use critterbox::viewer::{RerunSink, RerunTarget};
             let target = match (&args.rerun_save, &args.rerun_connect) {
                 (Some(path), _) => RerunTarget::Save(path.clone()),
                 (None, Some(url)) => RerunTarget::Connect(url.clone()),

@@ -2,8 +2,9 @@
 //! deaths, and energy and momentum over time as a table (`--plot` draws them).
 
 use super::replay::{sample, summary_head};
-use crate::recording::{plot, Recording};
+use crate::plot;
 use clap::Args;
+use critterbox::recording::Recording;
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -1,8 +1,8 @@
 //! `critterbox recover FILE`: a complete, readable copy of a cut-off recording (a run that was
 //! killed): every complete chunk's messages, the attachments and the metadata are kept.
 
-use crate::recording::recover::rewrite;
 use clap::Args;
+use critterbox::recording::recover::rewrite;
 use std::io::Write;
 use std::path::PathBuf;
 

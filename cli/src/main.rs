@@ -1,14 +1,17 @@
 //! The `critterbox` command: parses arguments, runs, and maps the outcome to an exit code.
 
+mod commands;
+mod plot;
+
 use clap::Parser;
 use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = critterbox::cli::Cli::parse();
+    let cli = commands::Cli::parse();
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    let result = critterbox::cli::execute(cli, &mut out).and_then(|()| Ok(out.flush()?));
+    let result = commands::execute(cli, &mut out).and_then(|()| Ok(out.flush()?));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // A closed pipe (`critterbox run | head`) is the reader's choice, not a failure.

@@ -1,11 +1,11 @@
 //! `critterbox test`: run the script tests (`fn test_*()` in `scripts/tests/*.rhai`).
 
-use crate::script::testing::{
-    discover, find_test_files, junit_xml, run_tests, TestOptions, TestOutcome,
-};
-use crate::script::{Limits, ScriptOptions};
 use anyhow::Context;
 use clap::Args;
+use critterbox::script::testing::{
+    discover, find_test_files, junit_xml, run_tests, TestOptions, TestOutcome,
+};
+use critterbox::script::{Limits, ScriptOptions};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -66,7 +66,7 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         record_failures: match &args.record_failures {
             Some(dir) if dir.as_os_str() == "none" => None,
             Some(dir) => Some(dir.clone()),
-            None => Some(crate::recording::path::default_dir().join("test-failures")),
+            None => Some(critterbox::recording::path::default_dir().join("test-failures")),
         },
         bless: args.bless,
     };

@@ -4,11 +4,11 @@
 //! `--rerun-save`, the run is re-simulated from the file and sent to the Rerun viewer step by
 //! step, each step's hash checked against the recording on the way.
 
-use crate::recording::replay::{state_at_step, Replay, StateSource};
-use crate::recording::schema::{id_of, StateMsg};
-use crate::recording::verify::verify;
-use crate::recording::{Recording, SceneSource};
 use clap::Args;
+use critterbox::recording::replay::{state_at_step, Replay, StateSource};
+use critterbox::recording::schema::{id_of, StateMsg};
+use critterbox::recording::verify::verify;
+use critterbox::recording::{Recording, SceneSource};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;

@@ -1,5 +1,8 @@
 //! The `critterbox` command as a user meets it: exit codes, messages, the default scene.
 
+/// The repository, where the scripts are.
+const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+
 use std::process::{Command, Output};
 
 fn critterbox(args: &[&str]) -> Output {
@@ -140,7 +143,7 @@ fn help_explains_the_run_options() {
 
 #[test]
 fn every_shipped_scene_script_runs_from_the_command_line() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/scenes");
+    let dir = std::path::Path::new(ROOT).join("scripts/scenes");
     let mut ran = 0;
     for entry in std::fs::read_dir(&dir).expect("scripts/scenes exists") {
         let path = entry.expect("a directory entry").path();
@@ -157,7 +160,7 @@ fn every_shipped_scene_script_runs_from_the_command_line() {
 
 #[test]
 fn set_overrides_a_scene_constant_and_rejects_unknown_ones() {
-    let cradle = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/scenes/cradle.rhai");
+    let cradle = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/scenes/cradle.rhai");
     let o = critterbox(&["run", cradle, "--set", "SPEED=2"]);
     assert!(o.status.success(), "{}", stderr(&o));
     // Five balls of mass 0.125 struck at 2: the momentum is 0.25 whichever ball carries it.
@@ -177,7 +180,7 @@ fn set_overrides_a_scene_constant_and_rejects_unknown_ones() {
 
 #[test]
 fn check_passes_shipped_scripts_and_fails_a_broken_one_with_its_line() {
-    let root = env!("CARGO_MANIFEST_DIR");
+    let root = ROOT;
     let mut args = vec!["check".to_string()];
     for sub in ["scripts/scenes", "scripts/kinds"] {
         for entry in std::fs::read_dir(format!("{root}/{sub}")).expect("scripts exist") {
@@ -210,7 +213,7 @@ fn every_method_runs_every_shipped_scene_script_and_calls_its_hooks() {
     // bullets_vs_player: bullets' collide hooks kill them and damage players; under every method
     // some bullets must have died (the hooks ran) and the run must succeed.
     let scene = concat!(
-        env!("CARGO_MANIFEST_DIR"),
+        concat!(env!("CARGO_MANIFEST_DIR"), "/.."),
         "/scripts/scenes/bullets_vs_player.rhai"
     );
     for m in ["discrete", "substep:2", "swept", "event", "auto"] {
@@ -229,7 +232,7 @@ fn every_method_runs_every_shipped_scene_script_and_calls_its_hooks() {
     );
     // Under gravity auto solves, and says how many critters sleep: the whole pile has come to
     // rest after 600 steps (10 s).
-    let pile = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/scenes/pile.rhai");
+    let pile = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/scenes/pile.rhai");
     let o = critterbox(&["run", pile, "--steps", "600", "--method", "auto"]);
     let out = stdout(&o);
     assert!(field(&out, "auto chose").starts_with("solve:8"), "{out}");

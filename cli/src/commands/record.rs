@@ -2,11 +2,9 @@
 //! recorder's start and end, and Ctrl-C, which ends the run early with the file finished.
 
 use super::run::RunArgs;
-use crate::recording::keyframes::default_record_every;
-use crate::recording::meta::utc_now;
-use crate::recording::{path, EndMeta, Recorder, RunMeta, SceneSource, Written};
-use crate::scenes::{AnyWorld, Scene};
 use clap::Args;
+use critterbox::recording::{path, EndMeta, Recorder, RunMeta, RunOverrides, Written};
+use critterbox::scenes::Scene;
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -48,45 +46,18 @@ pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::SeqCst)
 }
 
-fn world_seed(world: &AnyWorld) -> u64 {
-    match world {
-        AnyWorld::D2(w) => w.seed(),
-        AnyWorld::D3(w) => w.seed(),
-    }
-}
-
 /// The run's metadata.
 pub fn run_meta(args: &RunArgs, scene: &Scene, steps: u64) -> RunMeta {
-    let world = &scene.world;
-    let source = match scene.sources.first() {
-        Some(file) => SceneSource::Script {
-            file: file.path.clone(),
-        },
-        None => SceneSource::Builtin,
-    };
-    RunMeta {
-        version: env!("CARGO_PKG_VERSION").to_string(),
-        scene: scene.name.clone(),
-        source,
-        seed: world_seed(world),
-        seed_override: args.seed,
-        dt: world.dt(),
-        dt_override: args.dt,
-        steps,
-        method: world.method().to_string(),
-        dim: world.dim(),
-        border: format!("{:?}", world.border()).to_lowercase(),
+    let overrides = RunOverrides {
+        seed: args.seed,
+        dt: args.dt,
         n: args.n,
         sets: args.sets.clone(),
+        steps: Some(steps),
         limits: super::run::limits(args),
-        command_line: std::env::args().collect(),
-        record_every: args
-            .recording
-            .record_every
-            .unwrap_or_else(|| default_record_every(world.len())),
-        critters: world.len(),
-        created: utc_now().1,
-    }
+        record_every: args.recording.record_every,
+    };
+    RunMeta::for_scene(scene, &overrides)
 }
 
 /// A run's recorder, and how many of the scene's script files are in the file so far.
