@@ -173,8 +173,8 @@ fn stress(c: &mut Criterion) {
             world.sleepers(),
             stats.contacts,
             stats.pair_tests,
-            world.broad_phase_rebuilds(),
-            world.broad_phase_repairs()
+            world.diagnostics().list_rebuilds,
+            world.diagnostics().list_repairs
         );
     }
     group.finish();

@@ -759,13 +759,13 @@ mod tests {
             for (field, width, flip) in &fields {
                 for bit in 0..*width {
                     let slot = who.index;
-                    let c = w.critters.slot_mut(slot).expect("there");
+                    let c = w.state.critters.slot_mut(slot).expect("there");
                     let saved = c.clone();
                     flip(c, bit);
                     let (fast, portable) = both(&w);
                     assert_eq!(bits(&fast), bits(&portable), "{field} bit {bit}");
                     assert_ne!(w.state_hash(), h0, "{field} bit {bit} of {who:?}");
-                    *w.critters.slot_mut(slot).expect("there") = saved;
+                    *w.state.critters.slot_mut(slot).expect("there") = saved;
                 }
             }
         }
@@ -793,8 +793,8 @@ mod tests {
 
     /// The hash of `w` from every word: what is kept is dropped first.
     fn whole_hash<V: Vector>(w: &mut World<V>) -> u64 {
-        w.critters.forget_statics();
-        assert!(!w.critters.statics().is_kept());
+        w.state.critters.forget_statics();
+        assert!(!w.state.critters.statics().is_kept());
         w.state_hash()
     }
 
@@ -806,7 +806,10 @@ mod tests {
         for step in 0..20 {
             w.step().expect("steps");
             // Moving, colliding and bouncing off the walls leave the kept lanes in place...
-            assert!(w.critters.statics().is_kept(), "{method:?}, step {step}");
+            assert!(
+                w.state.critters.statics().is_kept(),
+                "{method:?}, step {step}"
+            );
             // ...and the hash that reuses them is the hash of every word.
             let kept = w.state_hash();
             assert_eq!(kept, whole_hash(&mut w), "{method:?}, step {step}");
@@ -844,37 +847,40 @@ mod tests {
                 w.get_mut(id).expect("there").traits_mut().health -= 1.0
             }),
             ("CritterSet::get_mut", |w, id| {
-                w.critters
+                w.state
+                    .critters
                     .get_mut(id)
                     .expect("there")
                     .traits_mut()
                     .restitution = 0.5
             }),
             ("CritterSet::slot_mut", |w, id| {
-                let c = w.critters.slot_mut(id.index).expect("there");
+                let c = w.state.critters.slot_mut(id.index).expect("there");
                 c.set_priority(1.0).expect("a priority");
             }),
             ("CritterSet::pair_mut", |w, id| {
-                let (a, _) = w.critters.pair_mut(id.index, id.index + 1);
+                let (a, _) = w.state.critters.pair_mut(id.index, id.index + 1);
                 a.props_mut().insert("tag".into(), PropValue::Int(7));
             }),
             ("CritterSet::iter_mut", |w, _| {
-                w.critters
+                w.state
+                    .critters
                     .iter_mut()
                     .for_each(|c| c.traits_mut().health += 1.0)
             }),
             ("CritterSet::par_iter_mut", |w, _| {
                 use rayon::prelude::*;
-                w.critters
+                w.state
+                    .critters
                     .par_iter_mut()
                     .for_each(|c| c.traits_mut().kind.0 ^= 0)
             }),
         ];
         for (name, write) in writes {
             let before = w.state_hash();
-            assert!(w.critters.statics().is_kept(), "{name}");
+            assert!(w.state.critters.statics().is_kept(), "{name}");
             write(&mut w, id);
-            assert!(!w.critters.statics().is_kept(), "{name}");
+            assert!(!w.state.critters.statics().is_kept(), "{name}");
             let after = w.state_hash();
             assert_eq!(after, whole_hash(&mut w), "{name}");
             if name != "CritterSet::par_iter_mut" {
@@ -884,7 +890,7 @@ mod tests {
         // Removing and spawning change the slots.
         w.state_hash();
         w.remove(id).expect("there");
-        assert!(!w.critters.statics().is_kept(), "remove");
+        assert!(!w.state.critters.statics().is_kept(), "remove");
         let after = w.state_hash();
         assert_eq!(after, whole_hash(&mut w), "remove");
     }
@@ -907,7 +913,8 @@ mod tests {
             panic!("gas is 2D")
         };
         w.state_hash();
-        w.critters
+        w.state
+            .critters
             .slot_mut_moving(0)
             .expect("there")
             .traits_mut()

@@ -33,6 +33,9 @@ pub mod error;
 pub mod hash;
 pub mod kind;
 pub mod method;
+mod pairs;
+mod parallel;
+mod prefetch;
 pub mod recording;
 pub mod response;
 pub mod rng;
@@ -61,7 +64,8 @@ pub use kind::{
     default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx,
 };
 pub use method::Method;
+pub use parallel::PARALLEL_MIN;
 pub use rng::Rng;
 pub use vector::Vector;
 pub use wall::WallBox;
-pub use world::{Locality, StepStats, World, WorldConfig};
+pub use world::{Diagnostics, Locality, StepStats, World, WorldConfig};

@@ -117,8 +117,39 @@ fn decode(code: u8) -> PairRule {
     }
 }
 
+/// [`roles_order`] for critters `ca` in slot `a` and `cb` in slot `b`: the slots of (caller, arg).
+#[inline]
+pub(crate) fn roles_slots<V: Vector>(
+    rule: PairRule,
+    (a, ca): (u32, &Critter<V>),
+    (b, cb): (u32, &Critter<V>),
+) -> Option<(u32, u32)> {
+    roles_order(rule, ca, cb).map(|(caller, _)| {
+        if std::ptr::eq(caller, ca) {
+            (a, b)
+        } else {
+            (b, a)
+        }
+    })
+}
+
+/// (caller, arg) for a pair under `rule`, or `None` when they don't collide.
+pub(crate) fn roles_order<'c, V: Vector>(
+    rule: PairRule,
+    a: &'c Critter<V>,
+    b: &'c Critter<V>,
+) -> Option<(&'c Critter<V>, &'c Critter<V>)> {
+    match rule {
+        PairRule::DontCollide => None,
+        PairRule::FirstCalls => Some((a, b)),
+        PairRule::SecondCalls => Some((b, a)),
+        PairRule::LowerIdCalls if a.id < b.id => Some((a, b)),
+        PairRule::LowerIdCalls => Some((b, a)),
+    }
+}
+
 /// Interned rule classes and the class-pair table.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct RuleCache {
     index: BTreeMap<(KindId, u64, bool), u32>,
     /// Per class: does its kind's rule depend on state?

@@ -122,21 +122,9 @@ impl AnyWorld {
     pub fn border(&self) -> Border {
         both!(self, w => w.topology().border)
     }
-    /// How many times the critters were laid out in memory along the grid.
-    pub fn layouts(&self) -> u64 {
-        both!(self, w => w.layouts())
-    }
-    /// How many times the broad phase rebuilt its Verlet list.
-    pub fn broad_phase_rebuilds(&self) -> u64 {
-        both!(self, w => w.broad_phase_rebuilds())
-    }
-    /// How many times the broad phase mended its Verlet list instead of rebuilding it.
-    pub fn broad_phase_repairs(&self) -> u64 {
-        both!(self, w => w.broad_phase_repairs())
-    }
-    /// How many steps the broad phase used the plain grid because its lists lived one step.
-    pub fn broad_phase_grid_steps(&self) -> u64 {
-        both!(self, w => w.broad_phase_grid_steps())
+    /// How the engine's caches and layouts have behaved (see [`crate::World::diagnostics`]).
+    pub fn diagnostics(&self) -> crate::world::Diagnostics<'_> {
+        both!(self, w => w.diagnostics())
     }
     /// Changes the time step.
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {

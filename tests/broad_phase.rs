@@ -224,16 +224,17 @@ fn gas_of_10000_candidate_pairs_are_unique_and_include_every_touching_pair() {
     for step in 0..45 {
         world.step().unwrap();
         let label = format!("step {step}");
-        let candidates = unique_pairs(world.candidate_pairs(), &label);
+        let candidates = unique_pairs(world.diagnostics().candidate_pairs, &label);
         assert_eq!(candidates.len(), world.stats().candidates);
         let contacts: Pairs = world
-            .contact_pairs()
+            .diagnostics()
+            .contact_pairs
             .iter()
             .map(|&(a, b)| (a.min(b), a.max(b)))
             .collect();
         assert_eq!(
             contacts.len(),
-            world.contact_pairs().len(),
+            world.diagnostics().contact_pairs.len(),
             "{label}: a contact listed twice"
         );
         assert!(
@@ -281,8 +282,8 @@ fn same_physics<V: Vector>(border: critterbox::Border, n: usize, steps: usize) {
         grid.step().unwrap();
         all.step().unwrap();
         assert_eq!(
-            grid.contact_pairs(),
-            all.contact_pairs(),
+            grid.diagnostics().contact_pairs,
+            all.diagnostics().contact_pairs,
             "{}D {border:?} step {step}: contacts differ",
             V::DIM
         );

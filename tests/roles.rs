@@ -317,10 +317,10 @@ fn collide_roles_are_cached_per_kind_pair_however_many_critters() {
             .unwrap();
     }
     world.run(30).unwrap();
-    let classes = world.rule_cache().classes();
+    let classes = world.diagnostics().rule_cache.classes();
     assert_eq!(classes, 4, "ball, red, blue and wall");
     let class_pairs = (classes * (classes + 1) / 2) as u64;
-    let computed = world.rule_cache().computed();
+    let computed = world.diagnostics().rule_cache.computed();
     assert!(
         computed <= class_pairs,
         "{computed} role computations for {class_pairs} class pairs"
@@ -336,7 +336,7 @@ fn collide_roles_are_cached_per_kind_pair_however_many_critters() {
     );
     world.run(10).unwrap();
     assert_eq!(
-        world.rule_cache().computed(),
+        world.diagnostics().rule_cache.computed(),
         computed,
         "nothing new to compute"
     );
@@ -370,7 +370,11 @@ fn kind_whose_rule_depends_on_state_is_asked_for_every_pair_every_step() {
         2 * candidates,
         "both sides asked for every candidate pair"
     );
-    assert_eq!(world.rule_cache().computed(), 0, "nothing cached");
+    assert_eq!(
+        world.diagnostics().rule_cache.computed(),
+        0,
+        "nothing cached"
+    );
 }
 
 /// A crowd large enough for the rules and narrow phase to run with the broad phase's re-test of

@@ -1,56 +1,33 @@
-//! `auto`: the cheapest method that keeps the scene's tolerances, decided each step and per
-//! critter.
+//! `auto`: the cheapest method that keeps the scene's tolerances, chosen each step ([`choose`]).
 //!
-//! The discrete step does not tunnel while no critter moves more than a fraction of the smallest
-//! radius or wall thickness per step (`docs/stability.md` measures where it starts to tunnel).
-//! Without gravity such a step is still event-driven where the event step keeps its flight from
-//! step to step (`crate::method::flight`): it then costs about what the discrete step does (the
-//! chart's gas at dt 1/960: 2.6 us per step against 2.8-3.0) and is exact. Where something
-//! outside the flight changes more than [`crate::method::flight::CHURN`] of the critters between
-//! steps (hooks steering them, critters coming and going), the kept flight would predict them
-//! all again every step, several discrete steps' cost, so such a step is discrete until the next
-//! step where a flight is set up on schedule, where the event step is tried again.
+//! * **Under gravity** critters come to rest on each other, and the discrete step lets stacks
+//!   sink into themselves, so the step is solved: `solve:8`, with one sweep more per
+//!   [`LAYERS_PER_SWEEP`] layers of a pile deeper than eight sweeps carry, up to
+//!   [`AUTO_MOST_SWEEPS`] ([`Sweeps::ByDepth`]); its islands at rest sleep. So that nothing
+//!   tunnels, the solved step is cut into as many substeps as keep every critter under
+//!   [`SOLVE_FRACTION`] of what would carry it through a wall or a disk ([`tunnel_fraction`]),
+//!   up to [`MOST_SOLVE_SUBSTEPS`]. A step that would need more is swept (resting contacts are
+//!   the event step's worst case); in a sparse scene (disks cover less than [`SPARSE`] of the
+//!   box) only the critters that are fast or may meet something along their line predict.
+//! * **Without gravity** nothing rests, and a solve would spread a Newton's cradle's momentum
+//!   over its balls, so the step is never solved. It is `event`, exact, with its flight kept
+//!   from step to step so that a step pays for its events, not for predicting everyone anew.
+//!   The one exception is a slow step (no critter moves more than [`SWEEP_FRACTION`] of the
+//!   smallest radius or wall thickness) in a scene where something outside the flight (hooks
+//!   steering critters, critters coming and going) changed more than
+//!   [`crate::method::flight::CHURN`] of the critters since the last step: a kept flight would
+//!   predict them all again every step, so such a step is discrete, which does not tunnel at
+//!   that speed, until the next step where a flight is set up on schedule.
 //!
-//! Beyond that fraction the step's collisions are found in time order, swept or event-driven.
-//! Without gravity nothing rests, and the event-driven step flies the swept step's events
-//! without its closing discrete pass, so the step is `event`, dense or sparse, its flight kept
-//! from one step to the next while auto keeps taking it: a step then pays for its events, not
-//! for predicting everyone anew (the chart's gas: the same error at event's cost, where swept
-//! costs 1.2 to 1.3 times more; a bullet among 360 slow disks, 120 steps: 12.8 us per step,
-//! where the event step taken per critter, as auto took it before, cost 36). Under gravity a
-//! step too fast for solved substeps stays swept, since resting contacts are the event step's
-//! worst case; in a sparse scene (disks cover less than [`SPARSE`] of the box) that swept step
-//! is taken per critter ([`crate::method::swept::step_where_needed`]): a slow critter that can
-//! meet nothing along its line this step makes no prediction until a collision changes its
-//! flight. The events are the same, so the accuracy is too; a few bullets among many
-//! spread-out slow critters cost the bullets' predictions, not everyone's. In a dense scene
-//! nearly every critter has something within reach, and the check would only add its cost
-//! (and wider cells), so everyone is swept.
-//!
-//! Under gravity, critters come to rest on each other, and the discrete step lets stacks sink
-//! into themselves (the deep pile of `docs/stability.md`: 1.92 radii after 2 s). So a step under
-//! gravity is solved, `solve:8`, at about the discrete step's cost (0.036 radii there), and its
-//! islands at rest sleep. Eight sweeps carry a pile about 16 contacts deep; a deeper one gets one
-//! sweep more per [`LAYERS_PER_SWEEP`] layers, up to [`AUTO_MOST_SWEEPS`], counted by the solve
-//! each time ([`Sweeps::ByDepth`]): without them a 90-layer pile never comes to rest, and never
-//! sleeps. So that no critter can tunnel, the solved step is cut into as many
-//! substeps as keep each critter under half of what would carry it through a wall or a disk in
-//! one substep ([`tunnel_fraction`]), up to [`MOST_SOLVE_SUBSTEPS`]; a step that would need more
-//! is swept. A heap falling fast is then solved as it lands: swept, a dense heap runs out of the
-//! swept step's event budget every step, and its discrete substeps let the heap sink into itself
-//! and through the floor. A pair that
-//! meets alone gets Pop's impulse from the solve, and a step with no contacts builds nothing to
-//! solve. Critters sliding down a pile move faster than the sweep threshold, which guards the
-//! angles of glancing hits; the solve's angles are the discrete step's, and it is the stack that
-//! matters there.
-//! Without gravity nothing rests, and `solve:n` would spread a Newton's cradle's momentum over
-//! its balls: the step stays discrete.
+//! `docs/methods.md` has the measured figures behind these thresholds, and
+//! `docs/stability.md` where each fixed method fails.
 
+use crate::method::flight;
 use crate::method::solve::{Sweeps, LAYERS_PER_SWEEP};
 use crate::method::swept::{count_fast, displacement, motion_scale, MotionScale, SWEEP_FRACTION};
 use crate::method::Method;
 use crate::vector::Vector;
-use crate::world::World;
+use crate::world::state::State;
 
 /// The sweeps of the `solve:n` step `auto` takes under gravity (the stability table's
 /// `solve:8`), at least.
@@ -66,7 +43,7 @@ pub const AUTO_MOST_SWEEPS: u32 = 64;
 pub const SPARSE: f64 = 0.05;
 
 /// The fraction of the box the live disks cover.
-pub fn packing<V: Vector>(world: &World<V>) -> f64 {
+pub(crate) fn packing<V: Vector>(world: &State<V>) -> f64 {
     let size = world.topo.size();
     let volume: f64 = (0..V::DIM).map(|axis| size.get(axis)).product();
     let unit = if V::DIM == 2 {
@@ -209,7 +186,7 @@ pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 /// plus the smaller of half the thinnest wall and the smallest radius, so that two critters
 /// under half their own bounds together move less than their two radii. 0 with nothing moving.
 /// `scale` is the world's [`motion_scale`].
-pub fn tunnel_fraction<V: Vector>(world: &World<V>, scale: &MotionScale) -> f64 {
+pub(crate) fn tunnel_fraction<V: Vector>(world: &State<V>, scale: &MotionScale) -> f64 {
     let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
     let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
     disks
@@ -217,12 +194,17 @@ pub fn tunnel_fraction<V: Vector>(world: &World<V>, scale: &MotionScale) -> f64 
         .fold(0.0, f64::max)
 }
 
-/// The method for the coming step and why.
-pub fn choose<V: Vector>(world: &World<V>) -> Choice {
+/// The method for the coming step and why, for `world` whose event flight is `flight` and in
+/// which `asleep` critters sleep.
+pub(crate) fn choose<V: Vector>(
+    world: &State<V>,
+    flight: &flight::Scratch<V>,
+    asleep: usize,
+) -> Choice {
     let scale = motion_scale(world);
     let (fastest, smallest) = (scale.fastest, scale.smallest());
     let limit = SWEEP_FRACTION * smallest;
-    let falling = world.gravity() != V::zero();
+    let falling = world.gravity != V::zero();
     let tunnel = if falling {
         tunnel_fraction(world, &scale)
     } else {
@@ -239,14 +221,14 @@ pub fn choose<V: Vector>(world: &World<V>) -> Choice {
             why: Why::Solve {
                 tunnel,
                 substeps,
-                asleep: world.sleepers(),
+                asleep,
             },
         }
     } else if fastest <= limit {
         // Without gravity (under it the step was solved above), the event step where its flight
         // can be kept: tried again from every step where a flight is set up on schedule, so the
         // choice does not depend on anything before such a step (a replay restores there).
-        let calm = !falling && !world.flight.churned(world.step_count);
+        let calm = !falling && !flight.churned(world.step_count);
         Choice {
             method: if calm {
                 Method::Event

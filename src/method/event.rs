@@ -11,21 +11,29 @@
 //! again), so a step pays for its events, not for predicting everyone anew. See `flight` for
 //! that, for the treatment of round-off, inelastic collapse and resting contacts.
 
+use super::flight;
 use crate::error::Error;
 use crate::method::swept::{finish_in_substeps, motion_scale, SWEEP_FRACTION};
 use crate::vector::Vector;
-use crate::world::{StepStats, World};
+use crate::world::stages::pairs::Pairs;
+use crate::world::state::State;
+use crate::world::stats::StepStats;
 
 /// One event-driven step of exactly dt (after the update hooks, before the lifecycle).
-pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
+pub(crate) fn step<V: Vector>(
+    state: &mut State<V>,
+    pairs: &mut Pairs<V>,
+    flight: &mut flight::Scratch<V>,
+    stats: &mut StepStats,
+) -> Result<(), Error> {
     let clock = std::time::Instant::now();
-    let g = world.gravity;
-    let stopped = crate::method::flight::run(world, g, world.dt, None, true, stats)?;
+    let (g, dt) = (state.gravity, state.dt);
+    let stopped = flight::run(state, flight, g, dt, None, true, stats)?;
     stats.response += clock.elapsed();
     if let Some(at) = stopped {
         stats.budget_exceeded += 1;
-        let limit = SWEEP_FRACTION * motion_scale(world).smallest();
-        finish_in_substeps(world, world.dt - at, limit, false, stats)?;
+        let limit = SWEEP_FRACTION * motion_scale(state).smallest();
+        finish_in_substeps(state, pairs, dt - at, limit, false, stats)?;
     }
     Ok(())
 }

@@ -42,14 +42,16 @@ use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
 use crate::error::Error;
-use crate::method::pair_key;
 use crate::method::queue::{Owned, Queue};
 use crate::method::toi::{
     smallest_nonneg_root, surely_no_toi_by, toi_ball_ball, toi_ball_ball_by, toi_wall_ball,
 };
+use crate::pairs::pair_key;
+use crate::rules::roles_order;
 use crate::rules::PairRule;
 use crate::vector::Vector;
-use crate::world::{at_step, roles_order, StepStats, World};
+use crate::world::state::{at_step, State};
+use crate::world::stats::StepStats;
 use std::cmp::Ordering;
 
 /// A kept flight is set up anew at every step whose number is a multiple of this (see the
@@ -383,14 +385,14 @@ struct Kept {
 /// if it may meet something along its line (`may_meet`); otherwise it joins in when a collision
 /// changes its flight. The events are the same as when everyone predicts.
 pub(crate) fn run<V: Vector>(
-    world: &mut World<V>,
+    world: &mut State<V>,
+    sc: &mut Scratch<V>,
     acc: V,
     t_end: f64,
     fast: Option<f64>,
     keep: bool,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
-    let mut sc = std::mem::take(&mut world.flight);
     sc.fast = fast;
     sc.grew = false;
     let step = world.step_count;
@@ -404,15 +406,15 @@ pub(crate) fn run<V: Vector>(
         .take()
         .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
     let out = match kept {
-        Some(_) => match resume(world, &mut sc, t_end, step) {
-            Ok(true) => fly_on(world, &mut sc, acc, t_end, stats),
+        Some(_) => match resume(world, sc, t_end, step) {
+            Ok(true) => fly_on(world, sc, acc, t_end, stats),
             Ok(false) => {
                 sc.churned_at = Some(step);
-                run_with(world, &mut sc, acc, t_end, life(keep, step), stats)
+                run_with(world, sc, acc, t_end, life(keep, step), stats)
             }
             Err(e) => Err(e),
         },
-        None => run_with(world, &mut sc, acc, t_end, life(keep, step), stats),
+        None => run_with(world, sc, acc, t_end, life(keep, step), stats),
     };
     if keep && !sc.grew && matches!(out, Ok(None)) && !(step + 1).is_multiple_of(FLIGHT_STEPS) {
         sc.kept = Some(Kept {
@@ -423,7 +425,6 @@ pub(crate) fn run<V: Vector>(
         sc.kept = None;
         sc.heap.reset(0, 0.0, 0.0);
     }
-    world.flight = sc;
     out
 }
 
@@ -439,7 +440,7 @@ fn life(keep: bool, step: u64) -> u64 {
 
 /// A kept flight flown on for one more step of `span`, from where the last one ended.
 fn fly_on<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     span: f64,
@@ -463,7 +464,7 @@ fn fly_on<V: Vector>(
 /// radius the flight's cells (or shells) were sized for: the flight then stops there, everyone
 /// is brought to that time, and a new flight, sized for the grown critter, flies the rest.
 fn run_with<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     t_end: f64,
@@ -499,7 +500,7 @@ enum Flight {
 /// Flies for `span` from flight time `from` (a kept flight that `resume` took up), or sets up a
 /// new flight whose predictions look `life` steps of `span` ahead and flies it from 0.
 fn fly<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     from: Option<f64>,
@@ -572,7 +573,7 @@ fn fly<V: Vector>(
             for x in [ev.a, ev.b] {
                 if ev.kind == PAIR || x == ev.a {
                     for &p in sc.near.members(x as usize) {
-                        crate::world::prefetch(sc.body.get(p as usize));
+                        crate::prefetch::prefetch(sc.body.get(p as usize));
                     }
                 }
             }
@@ -689,7 +690,7 @@ fn fly<V: Vector>(
 /// the flight cannot go on (the caller counts that as churned): a critter came or went, changed
 /// size, class or mobility, or a wall moved; the step then sets up a new flight.
 fn resume<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     span: f64,
     step: u64,
@@ -755,7 +756,7 @@ fn resume<V: Vector>(
 
 /// Sets up a new flight for a step of `span`, its predictions looking to `horizon`.
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
-fn setup<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, acc: V, span: f64, horizon: f64) {
+fn setup<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, acc: V, span: f64, horizon: f64) {
     let n = w.critters.slot_count();
     // A kept flight's calendar covers two steps (see `resume`).
     sc.heap
@@ -950,7 +951,7 @@ fn reach<V: Vector>(sc: &Scratch<V>, a: u32) -> f64 {
 /// The flight asks [`mark_who_may_meet`], which gives the same answers pair by pair; this is
 /// its definition, which the tests compare it with.
 #[cfg(test)]
-fn may_meet<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32) -> bool {
+fn may_meet<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32) -> bool {
     let body = sc.body[a as usize];
     if body.radius.is_nan() {
         return false;
@@ -978,7 +979,7 @@ fn may_meet<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32) -> bool {
 
 /// Whether a disk `body` that moves up to `mine` may reach a bounding border.
 #[inline]
-fn near_border<V: Vector>(w: &World<V>, body: Body<V>, mine: f64) -> bool {
+fn near_border<V: Vector>(w: &State<V>, body: Body<V>, mine: f64) -> bool {
     if w.topo.border == Border::Wrap {
         return false;
     }
@@ -990,7 +991,7 @@ fn near_border<V: Vector>(w: &World<V>, body: Body<V>, mine: f64) -> bool {
 }
 
 /// Whether disk `a`, moving up to `mine`, may reach a wall listed in the cells around its own.
-fn near_a_wall<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, mine: f64) -> bool {
+fn near_a_wall<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32, mine: f64) -> bool {
     let body = sc.body[a as usize];
     let mut around = [0usize; 27];
     let count = cells_around(w, sc, a, &mut around);
@@ -1016,7 +1017,7 @@ fn near_a_wall<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, mine: f64) -> b
 /// cells read once, in cell order, each pair of disks tested once for both of its disks, each
 /// side with `may_meet`'s own arithmetic), and the walls asked only by disks whose cell has a
 /// wall around it.
-fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
+fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
     let n = sc.body.len();
     let mut reaches = std::mem::take(&mut sc.reach);
     reaches.clear();
@@ -1111,7 +1112,7 @@ fn mark_who_may_meet<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
 
 /// Lists every pair whose shells overlap (at the start of a flight, every shell is centred on
 /// its critter).
-fn list_all<V: Vector>(w: &World<V>, sc: &mut Scratch<V>) {
+fn list_all<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
     let n = sc.body.len();
     sc.center.clear();
     sc.center
@@ -1155,7 +1156,7 @@ fn shells_overlap<V: Vector>(
 /// The keys of the cells around `a`'s cell (its own included), each once (at the grid's edges
 /// they are wrapped or cut at the border, and with fewer than three cells along an axis they
 /// repeat); their number.
-fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usize; 27]) -> usize {
+fn cells_around<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32, out: &mut [usize; 27]) -> usize {
     let home = sc.cell[a as usize] as usize;
     if interior::<V>(sc, a) {
         for (o, k) in sc.offsets.iter().zip(out.iter_mut()) {
@@ -1169,7 +1170,7 @@ fn cells_around<V: Vector>(w: &World<V>, sc: &Scratch<V>, a: u32, out: &mut [usi
 /// [`cells_around`] the cell at coordinates `hc`, by the general path (wrapped or cut at the
 /// grid's edges, each once).
 fn cells_around_cell<V: Vector>(
-    w: &World<V>,
+    w: &State<V>,
     sc: &Scratch<V>,
     hc: [i64; 3],
     out: &mut [usize; 27],
@@ -1199,7 +1200,7 @@ fn cells_around_cell<V: Vector>(
 /// Lists `a` again, centring its shell on where it is now (its body holds now): it empties its
 /// list, moves to the cell of its new centre, and lists the critters whose shells overlap the
 /// new one (and joins their lists). Its flight is unchanged, so no event is made stale.
-fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
+fn list_again<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
     let ai = a as usize;
     // The old neighbours keep `a` in their lists until they list again themselves: a pair
     // test too many costs less than finding `a` in every old list.
@@ -1228,7 +1229,7 @@ fn list_again<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
     // The loads are scattered, so each stage asks for what the next one reads before it
     // reads any: the cells' stripes, then the candidates' shell centres (with their radii),
     // then the new neighbours' lists.
-    use crate::world::prefetch;
+    use crate::prefetch::prefetch;
     for &k in &around[..count] {
         prefetch(sc.cells.head(k));
     }
@@ -1279,7 +1280,7 @@ fn predict_shell<V: Vector>(sc: &mut Scratch<V>, a: u32) {
 /// if that is within the flight.
 #[inline]
 fn shell_exit<V: Vector>(
-    w: &World<V>,
+    w: &State<V>,
     sc: &Scratch<V>,
     a: u32,
     t: f64,
@@ -1332,7 +1333,7 @@ fn coords(dims: &[usize; 3], k: usize) -> [i64; 3] {
 
 /// The cell of position `p`: its key and its coordinates (kept beside the key, which would
 /// take three divisions to unpack).
-fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) {
+fn cell_of<V: Vector>(w: &State<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) {
     let mut c = [0i64; 3];
     for (axis, ca) in c.iter_mut().enumerate().take(V::DIM) {
         let x = ((p.get(axis) - w.topo.min.get(axis)) / sc.side[axis]).floor() as i64;
@@ -1343,7 +1344,7 @@ fn cell_of<V: Vector>(w: &World<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) 
 
 /// Copies critter `a` into its body (after the flight or a hook changed it).
 #[inline]
-fn refresh<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32) {
+fn refresh<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: u32) {
     // Field by field into place: a body built whole on the stack and copied was read back
     // across two of its stores (a stall on every collision).
     let (body, meta) = (&mut sc.body[a as usize], &mut sc.meta[a as usize]);
@@ -1402,7 +1403,7 @@ fn state_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> (V, V, V) {
     )
 }
 
-fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+fn advance<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let m = sc.meta[a as usize];
     if !m.alive || m.wall {
         return;
@@ -1422,14 +1423,14 @@ fn advance<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
 /// with shells), so that the loads overlap the work on the event before it. Only a hint:
 /// nothing is read.
 #[inline]
-fn prefetch_event<V: Vector>(w: &World<V>, sc: &Scratch<V>, ev: &Ev) {
-    use crate::world::prefetch;
+fn prefetch_event<V: Vector>(w: &State<V>, sc: &Scratch<V>, ev: &Ev) {
+    use crate::prefetch::prefetch;
     let slots = w.critters.slot_slice();
     for x in [ev.a, ev.b] {
         let x = x as usize;
         prefetch(sc.body.get(x));
         prefetch(sc.center.get(x));
-        crate::world::prefetch_whole(slots.get(x));
+        crate::prefetch::prefetch_whole(slots.get(x));
         prefetch(sc.meta.get(x));
         prefetch(sc.near.head(x));
     }
@@ -1487,7 +1488,7 @@ fn push(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, kind: Kind) {
 
 /// Predicts every next event of disk `a` from time `t`. `initial`: pairs only with higher slots.
 fn predict_all<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
@@ -1514,7 +1515,7 @@ fn predict_all<V: Vector>(
         partners.clear();
         partners.extend_from_slice(sc.near.members(a as usize));
         for &b in &partners {
-            crate::world::prefetch(sc.body.get(b as usize));
+            crate::prefetch::prefetch(sc.body.get(b as usize));
         }
         // When `a` leaves its shell: offered last (`finish_prediction`), but a bound for the
         // pairs from the start.
@@ -1543,7 +1544,7 @@ fn predict_all<V: Vector>(
 /// Ends a prediction of `a` (in cell `home`) whose disk candidates are in: walls, then the
 /// pair and wall event kept as `best`, then borders and cells, and the earliest goes to the queue.
 fn finish_prediction<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     home: usize,
@@ -1580,7 +1581,7 @@ fn finish_prediction<V: Vector>(
 /// kept `best` event stands for the rest while its partner has not changed. Otherwise (a
 /// changed partner, a curved flight, an edge cell) the full prediction.
 fn predict_after_crossing<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     tag: u32,
@@ -1625,7 +1626,7 @@ fn interior_at<V: Vector>(sc: &Scratch<V>, hc: [i64; 3]) -> bool {
 /// Predicts `a` against the disks of cell `k`.
 #[inline(always)]
 fn scan_cell<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     k: usize,
@@ -1646,7 +1647,7 @@ fn scan_cell<V: Vector>(
 /// is inline; everything else goes to `predict_pair_or_wall`. Same result either way.
 #[inline(always)]
 fn predict_disk<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -1700,7 +1701,7 @@ fn look_ahead(horizon: f64, t: f64, limit: f64) -> f64 {
 /// pairs that would meet after `a` leaves its shell dropped (the shell event, offered after,
 /// would replace them: the chosen event is the same).
 fn predict_straight_partners<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     partners: &[u32],
@@ -1763,7 +1764,7 @@ fn predict_straight_partners<V: Vector>(
 /// Predicts `a`, in a cell at the edge of the grid, against the disks of the cells around
 /// it: wrapped or cut at the border, each cell once.
 fn scan_edge_neighbours<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
@@ -1779,7 +1780,7 @@ fn scan_edge_neighbours<V: Vector>(
 
 #[inline]
 fn predict_pair_or_wall<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -1870,7 +1871,7 @@ fn predict_pair_or_wall<V: Vector>(
 /// they don't collide, or they touch now and were just handled.
 #[inline(never)]
 fn offer_pair<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -1932,7 +1933,7 @@ fn advance_to_contact(gap: impl Fn(f64) -> f64, speed: f64, horizon: f64, scale:
 }
 
 /// Border hits of disk `a` (`mine`: its position, velocity and acceleration at `t`).
-fn predict_border<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64, mine: (V, V, V)) {
+fn predict_border<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: u32, t: f64, mine: (V, V, V)) {
     if w.topo.border == Border::Wrap {
         return;
     }
@@ -1981,7 +1982,7 @@ fn on_bound(v: f64, a: f64) -> Option<f64> {
     }
 }
 
-fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
+fn bounce_border<V: Vector>(w: &mut State<V>, a: u32, tag: u32) {
     let (axis, side) = ((tag / 2) as usize, tag % 2);
     let border = w.topo.border;
     let (lo, hi) = (w.topo.min.get(axis), w.topo.max.get(axis));
@@ -2003,7 +2004,7 @@ fn bounce_border<V: Vector>(w: &mut World<V>, a: u32, tag: u32) {
 }
 
 #[allow(clippy::needless_range_loop)]
-fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+fn predict_cell<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let (p, v, acc) = state_at(sc, a, t);
     let cc = sc.coord[a as usize];
     let mut best = (f64::INFINITY, 0u32);
@@ -2050,7 +2051,7 @@ fn predict_cell<V: Vector>(w: &World<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
 #[inline]
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 fn predict_cell_straight<V: Vector>(
-    w: &World<V>,
+    w: &State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
@@ -2092,7 +2093,7 @@ fn predict_cell_straight<V: Vector>(
 }
 
 #[allow(clippy::needless_range_loop)]
-fn cross_cell<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32, tag: u32, t: f64) {
+fn cross_cell<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32, tag: u32, t: f64) {
     advance(w, sc, a, t);
     let (axis, dir) = ((tag / 2) as usize, tag % 2);
     let old = sc.cell[a as usize] as usize;
@@ -2126,7 +2127,7 @@ fn move_cell<V: Vector>(sc: &mut Scratch<V>, a: u32, old: usize, new: usize, cc:
 }
 
 /// After a hook ran: the critter may have died or been moved; put it in the right cell.
-fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
+fn relocate<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
     if sc.shells {
         // Listed again when it died, grew, or was moved out of its shell.
         let stays = w.critters.slot(a).is_some_and(|c| {
@@ -2157,7 +2158,7 @@ fn relocate<V: Vector>(w: &mut World<V>, sc: &mut Scratch<V>, a: u32) {
 
 /// Hands a touching pair to the caller's `collide` hook (Pop's roles), with the TC model.
 fn collide<V: Vector>(
-    w: &mut World<V>,
+    w: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -2216,14 +2217,6 @@ fn collide<V: Vector>(
     out
 }
 
-impl<V: Vector> World<V> {
-    /// The collision virial of the last event or swept step: the sum over disk-disk default
-    /// collisions of contact distance x impulse (for pressure, `docs/methods.md`).
-    pub fn collision_virial(&self) -> f64 {
-        self.flight.virial
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use crate::scenes::{gas, GasParams};
@@ -2240,7 +2233,7 @@ mod tests {
         })
         .expect("the gas builds");
         w.set_method(Method::Event).expect("event");
-        w.flight.no_shells = no_shells;
+        w.methods.flight.no_shells = no_shells;
         w
     }
 
@@ -2301,16 +2294,16 @@ mod tests {
             with_cells += cells.stats().impacts;
         }
         assert!(
-            shells.flight.shells,
+            shells.methods.flight.shells,
             "the 3D periodic gas lists neighbours in shells"
         );
-        assert!(!cells.flight.shells);
+        assert!(!cells.methods.flight.shells);
         assert!(
             with_cells > 2 * 512,
             "{with_cells} collisions: too few to compare"
         );
         assert_eq!(with_shells, with_cells);
-        let topo = shells.topo;
+        let topo = shells.state.topo;
         let worst = shells
             .critters()
             .iter()
@@ -2346,7 +2339,7 @@ mod tests {
                     }
                 }
                 w.set_method(Method::Event).expect("event");
-                w.flight.no_keep = no_keep;
+                w.methods.flight.no_keep = no_keep;
                 w
             };
             let (mut kept, mut fresh) = (build(false), build(true));
@@ -2364,7 +2357,7 @@ mod tests {
                         }
                     }
                 }
-                resumed += usize::from(kept.flight.kept.is_some());
+                resumed += usize::from(kept.methods.flight.kept.is_some());
                 kept.step().expect("steps");
                 fresh.step().expect("steps");
                 with_kept += kept.stats().impacts;
@@ -2374,13 +2367,13 @@ mod tests {
                 resumed >= steps / 2,
                 "the flight went on in only {resumed} of {steps} steps"
             );
-            assert!(fresh.flight.kept.is_none());
+            assert!(fresh.methods.flight.kept.is_none());
             assert!(
                 with_fresh > 2 * n,
                 "{with_fresh} collisions: too few to compare"
             );
             assert_eq!(with_kept, with_fresh);
-            let topo = kept.topo;
+            let topo = kept.state.topo;
             let cs: Vec<_> = kept.critters().iter().collect();
             let worst = cs
                 .iter()
@@ -2441,7 +2434,7 @@ mod tests {
                 .expect("the gas builds")
             };
             if border != Border::Wrap {
-                let (lo, hi) = (w.topo.min, w.topo.max);
+                let (lo, hi) = (w.state.topo.min, w.state.topo.max);
                 let mid = (lo + hi) * 0.5;
                 let mut a = mid;
                 a.set(0, lo.get(0) + 2.0);
@@ -2467,14 +2460,14 @@ mod tests {
                 w.step().expect("steps");
             }
             let limit = 0.25 * 0.5;
-            let mut sc = std::mem::take(&mut w.flight);
+            let mut sc = std::mem::take(&mut w.methods.flight);
             sc.fast = Some(limit);
-            let dt = w.dt;
-            super::setup(&mut w, &mut sc, V::zero(), dt, dt);
-            super::mark_who_may_meet(&w, &mut sc);
+            let dt = w.dt();
+            super::setup(&mut w.state, &mut sc, V::zero(), dt, dt);
+            super::mark_who_may_meet(&w.state, &mut sc);
             let (mut yes, mut no) = (0, 0);
             for a in 0..sc.body.len() as u32 {
-                let want = super::may_meet(&w, &sc, a);
+                let want = super::may_meet(&w.state, &sc, a);
                 assert_eq!(sc.meets[a as usize], want, "disk {a}");
                 if sc.body[a as usize].radius.is_nan() {
                     continue;
@@ -2509,12 +2502,12 @@ mod tests {
                 ..GasParams::default()
             })
             .expect("the gas builds");
-            let mut sc = std::mem::take(&mut w.flight);
-            let dt = w.dt;
-            super::setup(&mut w, &mut sc, V::zero(), dt, dt);
+            let mut sc = std::mem::take(&mut w.methods.flight);
+            let dt = w.dt();
+            super::setup(&mut w.state, &mut sc, V::zero(), dt, dt);
             let total: usize = sc.dims[..V::DIM].iter().product();
             let cap = 2 * n;
-            let widest = (w.topo.size().get(0) / 1.0).floor() as usize;
+            let widest = (w.state.topo.size().get(0) / 1.0).floor() as usize;
             let unconstrained = widest.pow(V::DIM as u32);
             assert!(total <= cap, "{total} cells for {n} disks");
             assert!(
@@ -2554,7 +2547,7 @@ mod tests {
         let all: Vec<_> = w.critters().iter().collect();
         for (i, a) in all.iter().enumerate() {
             for b in &all[i + 1..] {
-                let gap = w.topo.delta(a.pos, b.pos).length() - a.radius - b.radius;
+                let gap = w.state.topo.delta(a.pos, b.pos).length() - a.radius - b.radius;
                 assert!(gap > -1e-9, "overlap {gap:e}");
             }
         }

@@ -9,20 +9,22 @@
 //! * [`Method::Solve`]: the discrete step with its contacts solved together ([`solve`]): `n`
 //!   sweeps of sequential impulses over every contact, then a partial position correction, so
 //!   piles and stacks come to rest; under gravity, islands at rest then sleep ([`sleep`]).
-//! * [`Method::Auto`]: discrete, swept or `solve:8` per step from the scene's speeds and gravity,
-//!   and within a swept step predictions only for the critters that are fast or may meet
-//!   something ([`auto`]).
+//! * [`Method::Auto`]: per step, `solve:8` (with more sweeps for deep piles) under gravity,
+//!   `event` without it, `discrete` for a slow step whose flight something outside it keeps
+//!   changing, and `swept` for a step under gravity too fast for solved substeps ([`auto`]).
 //!
 //! Every method keeps Pop's roles: a touching pair is handed to the caller's `collide` hook.
 //! [`flight`] is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
 //! formulas.
 
 pub mod auto;
+pub(crate) mod discrete;
 pub mod event;
 pub(crate) mod flight;
 mod queue;
 pub mod sleep;
 pub mod solve;
+pub(crate) mod state;
 pub mod swept;
 pub mod toi;
 
@@ -30,17 +32,6 @@ pub use flight::FLIGHT_STEPS;
 
 use std::fmt;
 use std::str::FromStr;
-
-/// The key of a pair of slots, whichever comes first: lower slot, then higher, so that keys sort
-/// by lower slot and then higher.
-pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
-    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
-}
-
-/// The (lower, higher) slots of a [`pair_key`].
-pub(crate) fn unpair_key(key: u64) -> (u32, u32) {
-    ((key >> 32) as u32, key as u32)
-}
 
 /// How a world's step finds and resolves collisions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

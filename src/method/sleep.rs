@@ -88,11 +88,6 @@ impl<V: Vector> Sleep<V> {
         *self = Sleep::new(!self.off);
     }
 
-    /// True when some critter sleeps.
-    pub(crate) fn any(&self) -> bool {
-        self.sleepers > 0
-    }
-
     /// How many critters sleep.
     pub(crate) fn count(&self) -> usize {
         self.sleepers

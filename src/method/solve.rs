@@ -39,9 +39,11 @@
 
 use crate::context::CollisionEvent;
 use crate::error::Error;
-use crate::method::{pair_key, unpair_key};
+use crate::method::sleep::Sleep;
+use crate::pairs::{pair_key, unpair_key};
 use crate::vector::Vector;
-use crate::world::World;
+use crate::world::stages::pairs::Pairs;
+use crate::world::state::State;
 
 /// Sweeps of `solve` when the method is named without a count.
 pub const DEFAULT_SWEEPS: u32 = 8;
@@ -88,7 +90,7 @@ pub fn sweeps_for_depth(depth: u32, least: u32, most: u32) -> u32 {
 /// Position sweeps per step (fewer once every overlap is within three slops).
 pub const POSITION_SWEEPS: u32 = 3;
 
-/// The sweeps take the contacts this many apart (see [`World::stage_solve`]).
+/// The sweeps take the contacts this many apart (see [`respond`]).
 const INTERLEAVE: usize = 16;
 
 /// One contact of the velocity sweeps: only what they read, so that the rows of a large pile
@@ -168,295 +170,292 @@ impl<V> Default for Scratch<V> {
     }
 }
 
-impl<V: Vector> World<V> {
-    /// The response stage of `solve:n`: hooks first, then the rest solved together, after a move
-    /// of `h` (the step, or under `auto` a substep of it). Returns how many pairs were handled.
-    pub(crate) fn stage_solve(&mut self, sweeps: Sweeps, h: f64) -> Result<usize, Error> {
-        let mut scratch = std::mem::take(&mut self.solve);
-        let result = self.solve_with(&mut scratch, sweeps, h);
-        self.solve = scratch;
-        result
-    }
-
-    fn solve_with(&mut self, s: &mut Scratch<V>, sweeps: Sweeps, h: f64) -> Result<usize, Error> {
-        let mut handled = 0;
-        // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
-        s.plain.clear();
-        let plain = &mut s.plain;
-        let contacts = std::mem::take(&mut self.contacts);
-        let result = contacts
-            .iter()
-            .try_for_each(|&(caller, arg)| self.hook_or_keep(caller, arg, plain, &mut handled));
-        self.contacts = contacts;
-        result?;
-        let wall_pairs = std::mem::take(&mut self.wall_pairs);
-        let result = wall_pairs.iter().try_for_each(|&(first, second, ask)| {
-            let Some((caller, arg)) = self.touching_wall_pair(first, second, ask)? else {
-                return Ok(());
-            };
-            self.contacts.push((caller, arg));
-            self.hook_or_keep(caller, arg, plain, &mut handled)
-        });
-        self.wall_pairs = wall_pairs;
-        result?;
-        self.sleep.flush(); // the islands of the sleepers the hooks took
-
-        // 2. The rows, where the hooks left the critters.
-        s.bodies.clear();
-        s.pos.clear();
-        let still = self.sleep.still();
-        // No contacts to solve (a pile asleep): no bodies either.
-        let slots = match s.plain.is_empty() {
-            true => &[][..],
-            false => self.critters.slot_slice(),
-        };
-        for (i, slot) in slots.iter().enumerate() {
-            match slot {
-                Some(c) if c.alive => {
-                    // To an awake critter a sleeper is as heavy as a wall.
-                    let asleep = still.get(i).copied().unwrap_or(false);
-                    s.bodies.push(Body {
-                        vel: c.vel,
-                        inv_mass: if asleep { 0.0 } else { c.inv_mass() },
-                    });
-                    s.pos.push(c.pos);
-                }
-                _ => {
-                    s.bodies.push(Body {
-                        vel: V::zero(),
-                        inv_mass: 0.0,
-                    });
-                    s.pos.push(V::zero());
-                }
-            }
-        }
-        s.shift.clear();
-        s.shift.extend(s.bodies.iter().map(|body| body.vel));
-        let resting = RESTING_STEPS * self.gravity.length() * h;
-        s.rows.clear();
-        s.rests.clear();
-        s.keys.clear();
-        let first_event = self.events.collisions.len();
-        let mut warm = Warm::new(&s.warm);
-        for &(a, b) in &s.plain {
-            let (Some(ca), Some(cb)) = (self.critters.slot(a), self.critters.slot(b)) else {
-                continue;
-            };
-            if !ca.alive || !cb.alive {
-                continue;
-            }
-            let Some(c) = crate::response::contact_between(&self.topo, ca, cb) else {
-                continue;
-            };
-            let (ba, bb) = (s.bodies[a as usize], s.bodies[b as usize]);
-            let (ia, ib) = (ba.inv_mass, bb.inv_mass);
-            if ia + ib == 0.0 {
-                continue; // two fixed critters: nothing can move
-            }
-            let v0 = (bb.vel - ba.vel).dot(c.normal);
-            let e = ca.restitution().min(cb.restitution());
-            let scale = match (ca.is_wall(), cb.is_wall()) {
-                (true, _) => cb.radius,
-                (_, true) => ca.radius,
-                _ => ca.radius.min(cb.radius),
-            };
-            // The last step's impulse of the pair is given again before the sweeps (warm start),
-            // once every row's approach speed is known.
-            let key = pair_key(a, b);
-            let start = warm.impulse(key);
-            s.keys.push(key);
-            s.rows.push(Row {
-                a,
-                b,
-                n: c.normal,
-                k: 1.0 / (ia + ib),
-                target: if v0 < -resting { -e * v0 } else { 0.0 },
-                impulse: start,
-            });
-            s.rests.push(Rest {
-                depth: c.depth,
-                scale,
-                event: s.rests.len() as u32,
-            });
-            self.events.collisions.push(CollisionEvent {
-                caller: ca.id,
-                arg: cb.id,
-                point: ca.pos + c.point,
-                normal: c.normal,
-                impulse: 0.0,
-            });
-        }
-
-        for row in &s.rows {
-            let (a, b) = (row.a as usize, row.b as usize);
-            let ja = row.impulse * s.bodies[a].inv_mass;
-            let jb = row.impulse * s.bodies[b].inv_mass;
-            s.bodies[a].vel -= row.n * ja;
-            s.bodies[b].vel += row.n * jb;
-        }
-
-        // Rows next to each other in the contact order mostly share a critter, and each would
-        // wait for the one before it to store its velocity: taken INTERLEAVE apart, the sweeps'
-        // neighbours are mostly independent and their work overlaps.
-        s.spare.clear();
-        s.spare_rests.clear();
-        for start in 0..INTERLEAVE.min(s.rows.len()) {
-            s.spare.extend(s.rows[start..].iter().step_by(INTERLEAVE));
-            s.spare_rests
-                .extend(s.rests[start..].iter().step_by(INTERLEAVE));
-        }
-        std::mem::swap(&mut s.rows, &mut s.spare);
-        std::mem::swap(&mut s.rests, &mut s.spare_rests);
-
-        // 3. Velocities: sweeps of sequential impulses, alternately forwards and backwards.
-        let count = match sweeps {
-            Sweeps::Fixed(n) => n,
-            Sweeps::ByDepth { least, most } => {
-                let g = self.gravity.length();
-                let down = if g > 0.0 {
-                    self.gravity * (1.0 / g)
-                } else {
-                    V::zero()
-                };
-                let depth = contact_depth(&s.rows, &s.bodies, down, &mut s.graph);
-                sweeps_for_depth(depth, least, most)
-            }
-        };
-        s.swept = if s.rows.is_empty() { 0 } else { count };
-        for sweep in 0..s.swept {
-            if sweep % 2 == 0 {
-                for row in s.rows.iter_mut() {
-                    push_velocities(row, &mut s.bodies);
-                }
-            } else {
-                for row in s.rows.iter_mut().rev() {
-                    push_velocities(row, &mut s.bodies);
-                }
-            }
-        }
-
-        // The move advanced each critter by its velocity before the solve; it should have gone
-        // by the solved one (x + v' dt, semi-implicit Euler with the impulses in v'): a ball
-        // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
-        // before the solve.
-        let dt = h;
-        for (shift, body) in s.shift.iter_mut().zip(&s.bodies) {
-            *shift = (body.vel - *shift) * dt;
-        }
-
-        // 4. Positions: part of each overlap removed, velocities untouched.
-        for _ in 0..POSITION_SWEEPS {
-            let mut deepest = f64::NEG_INFINITY;
-            for (row, rest) in s.rows.iter().zip(&s.rests) {
-                let (a, b) = (row.a as usize, row.b as usize);
-                let n = row.n;
-                let depth = rest.depth - (s.shift[b] - s.shift[a]).dot(n);
-                let slop = SLOP * rest.scale;
-                deepest = deepest.max(depth - 3.0 * slop);
-                let fix = (POSITION_SHARE * (depth - slop)).min(LARGEST_CORRECTION * rest.scale);
-                if fix > 0.0 {
-                    let push = fix * row.k;
-                    s.shift[a] -= n * (push * s.bodies[a].inv_mass);
-                    s.shift[b] += n * (push * s.bodies[b].inv_mass);
-                }
-            }
-            if deepest <= 0.0 {
-                break;
-            }
-        }
-
-        // 5. Back to the critters; the events get their impulses.
-        for (row, rest) in s.rows.iter().zip(&s.rests) {
-            if let Some(event) = self
-                .events
-                .collisions
-                .get_mut(first_event + rest.event as usize)
-            {
-                event.impulse = row.impulse;
-            }
-        }
-        // The impulses kept for the next step's warm start, in key order: the rows were built
-        // from two runs in key order (disk pairs, then wall pairs), merged here.
-        let impulses: Vec<f64> = self.events.collisions[first_event..]
-            .iter()
-            .map(|e| e.impulse)
-            .collect();
-        // Pairs of sleepers (or of a sleeper and a wall) had no row: their impulses are kept
-        // as they were, for when the island wakes.
-        let still = self.sleep.still();
-        let both_still = |&&(key, _): &&(u64, f64)| {
-            let (lo, hi) = unpair_key(key);
-            let still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
-            still(lo) && still(hi)
-        };
-        let asleep: Vec<(u64, f64)> = match still.is_empty() {
-            true => Vec::new(),
-            false => s.warm.iter().filter(both_still).copied().collect(),
-        };
-        s.warm.clear();
-        let split = s
-            .keys
-            .windows(2)
-            .position(|w| w[1] < w[0])
-            .map_or(s.keys.len(), |i| i + 1);
-        let (mut i, mut j) = (0, split);
-        while i < split || j < s.keys.len() {
-            let take_first = j == s.keys.len() || (i < split && s.keys[i] < s.keys[j]);
-            let k = if take_first { &mut i } else { &mut j };
-            if impulses[*k] > 0.0 {
-                s.warm.push((s.keys[*k], impulses[*k]));
-            }
-            *k += 1;
-        }
-        if !asleep.is_empty() {
-            let solved = std::mem::take(&mut s.warm);
-            s.warm = merge_by_key(&solved, &asleep);
-        }
-        if !s.rows.is_empty() {
-            let slots = self.critters.slots_mut_moving().iter_mut().enumerate();
-            for (i, c) in slots.filter_map(|(i, c)| Some((i, c.as_mut()?))) {
-                if s.bodies[i].inv_mass > 0.0 {
-                    c.vel = s.bodies[i].vel;
-                    c.pos = s.pos[i] + s.shift[i];
-                }
-            }
-        }
-        // The hooks or the position sweeps may have pushed a critter across the edge.
-        self.wrap_positions();
-        if self.sleep.active {
-            let speed = crate::method::sleep::SLEEP_SPEED_STEPS * self.gravity.length() * dt;
-            self.sleep
-                .after_solve(self.critters.slots_mut_moving(), &self.contacts, speed);
-        }
-        Ok(handled + s.rows.len())
-    }
-
-    /// Calls `caller`'s own `collide` on the pair (counted in `handled` when it touched), or
-    /// keeps the pair for the solve when the caller's kind has none.
-    fn hook_or_keep(
-        &mut self,
-        caller: u32,
-        arg: u32,
-        plain: &mut Vec<(u32, u32)>,
-        handled: &mut usize,
-    ) -> Result<(), Error> {
-        if !self.own_collide(caller) {
-            plain.push((caller, arg));
+/// The response stage of `solve:n`: hooks first, then the rest solved together, after a move of
+/// `h` (the step, or under `auto` a substep of it). Returns how many pairs were handled.
+pub(crate) fn respond<V: Vector>(
+    state: &mut State<V>,
+    pairs: &mut Pairs<V>,
+    s: &mut Scratch<V>,
+    sleep: &mut Sleep<V>,
+    sweeps: Sweeps,
+    h: f64,
+) -> Result<usize, Error> {
+    let mut handled = 0;
+    // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
+    s.plain.clear();
+    let plain = &mut s.plain;
+    let result = pairs.contacts.iter().try_for_each(|&(caller, arg)| {
+        hook_or_keep(state, sleep, caller, arg, plain, &mut handled)
+    });
+    result?;
+    let wall_pairs = std::mem::take(&mut pairs.wall_pairs);
+    let result = wall_pairs.iter().try_for_each(|&(first, second, ask)| {
+        let Some((caller, arg)) = state.touching_wall_pair(first, second, ask)? else {
             return Ok(());
+        };
+        pairs.contacts.push((caller, arg));
+        hook_or_keep(state, sleep, caller, arg, plain, &mut handled)
+    });
+    pairs.wall_pairs = wall_pairs;
+    result?;
+    sleep.flush(); // the islands of the sleepers the hooks took
+
+    // 2. The rows, where the hooks left the critters.
+    s.bodies.clear();
+    s.pos.clear();
+    let still = sleep.still();
+    // No contacts to solve (a pile asleep): no bodies either.
+    let slots = match s.plain.is_empty() {
+        true => &[][..],
+        false => state.critters.slot_slice(),
+    };
+    for (i, slot) in slots.iter().enumerate() {
+        match slot {
+            Some(c) if c.alive => {
+                // To an awake critter a sleeper is as heavy as a wall.
+                let asleep = still.get(i).copied().unwrap_or(false);
+                s.bodies.push(Body {
+                    vel: c.vel,
+                    inv_mass: if asleep { 0.0 } else { c.inv_mass() },
+                });
+                s.pos.push(c.pos);
+            }
+            _ => {
+                s.bodies.push(Body {
+                    vel: V::zero(),
+                    inv_mass: 0.0,
+                });
+                s.pos.push(V::zero());
+            }
         }
-        self.sleep.stir(caller, arg);
-        if self.collide_pair(caller, arg)? {
-            *handled += 1;
+    }
+    s.shift.clear();
+    s.shift.extend(s.bodies.iter().map(|body| body.vel));
+    let resting = RESTING_STEPS * state.gravity.length() * h;
+    s.rows.clear();
+    s.rests.clear();
+    s.keys.clear();
+    let first_event = state.events.collisions.len();
+    let mut warm = Warm::new(&s.warm);
+    for &(a, b) in &s.plain {
+        let (Some(ca), Some(cb)) = (state.critters.slot(a), state.critters.slot(b)) else {
+            continue;
+        };
+        if !ca.alive || !cb.alive {
+            continue;
         }
-        Ok(())
+        let Some(c) = crate::response::contact_between(&state.topo, ca, cb) else {
+            continue;
+        };
+        let (ba, bb) = (s.bodies[a as usize], s.bodies[b as usize]);
+        let (ia, ib) = (ba.inv_mass, bb.inv_mass);
+        if ia + ib == 0.0 {
+            continue; // two fixed critters: nothing can move
+        }
+        let v0 = (bb.vel - ba.vel).dot(c.normal);
+        let e = ca.restitution().min(cb.restitution());
+        let scale = match (ca.is_wall(), cb.is_wall()) {
+            (true, _) => cb.radius,
+            (_, true) => ca.radius,
+            _ => ca.radius.min(cb.radius),
+        };
+        // The last step's impulse of the pair is given again before the sweeps (warm start),
+        // once every row's approach speed is known.
+        let key = pair_key(a, b);
+        let start = warm.impulse(key);
+        s.keys.push(key);
+        s.rows.push(Row {
+            a,
+            b,
+            n: c.normal,
+            k: 1.0 / (ia + ib),
+            target: if v0 < -resting { -e * v0 } else { 0.0 },
+            impulse: start,
+        });
+        s.rests.push(Rest {
+            depth: c.depth,
+            scale,
+            event: s.rests.len() as u32,
+        });
+        state.events.collisions.push(CollisionEvent {
+            caller: ca.id,
+            arg: cb.id,
+            point: ca.pos + c.point,
+            normal: c.normal,
+            impulse: 0.0,
+        });
     }
 
-    /// True when `slot`'s kind has its own `collide` hook.
-    fn own_collide(&self, slot: u32) -> bool {
-        self.critters
-            .slot(slot)
-            .is_some_and(|c| self.kinds.get(c.kind()).has_collide)
+    for row in &s.rows {
+        let (a, b) = (row.a as usize, row.b as usize);
+        let ja = row.impulse * s.bodies[a].inv_mass;
+        let jb = row.impulse * s.bodies[b].inv_mass;
+        s.bodies[a].vel -= row.n * ja;
+        s.bodies[b].vel += row.n * jb;
     }
+
+    // Rows next to each other in the contact order mostly share a critter, and each would
+    // wait for the one before it to store its velocity: taken INTERLEAVE apart, the sweeps'
+    // neighbours are mostly independent and their work overlaps.
+    s.spare.clear();
+    s.spare_rests.clear();
+    for start in 0..INTERLEAVE.min(s.rows.len()) {
+        s.spare.extend(s.rows[start..].iter().step_by(INTERLEAVE));
+        s.spare_rests
+            .extend(s.rests[start..].iter().step_by(INTERLEAVE));
+    }
+    std::mem::swap(&mut s.rows, &mut s.spare);
+    std::mem::swap(&mut s.rests, &mut s.spare_rests);
+
+    // 3. Velocities: sweeps of sequential impulses, alternately forwards and backwards.
+    let count = match sweeps {
+        Sweeps::Fixed(n) => n,
+        Sweeps::ByDepth { least, most } => {
+            let g = state.gravity.length();
+            let down = if g > 0.0 {
+                state.gravity * (1.0 / g)
+            } else {
+                V::zero()
+            };
+            let depth = contact_depth(&s.rows, &s.bodies, down, &mut s.graph);
+            sweeps_for_depth(depth, least, most)
+        }
+    };
+    s.swept = if s.rows.is_empty() { 0 } else { count };
+    for sweep in 0..s.swept {
+        if sweep % 2 == 0 {
+            for row in s.rows.iter_mut() {
+                push_velocities(row, &mut s.bodies);
+            }
+        } else {
+            for row in s.rows.iter_mut().rev() {
+                push_velocities(row, &mut s.bodies);
+            }
+        }
+    }
+
+    // The move advanced each critter by its velocity before the solve; it should have gone
+    // by the solved one (x + v' dt, semi-implicit Euler with the impulses in v'): a ball
+    // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
+    // before the solve.
+    let dt = h;
+    for (shift, body) in s.shift.iter_mut().zip(&s.bodies) {
+        *shift = (body.vel - *shift) * dt;
+    }
+
+    // 4. Positions: part of each overlap removed, velocities untouched.
+    for _ in 0..POSITION_SWEEPS {
+        let mut deepest = f64::NEG_INFINITY;
+        for (row, rest) in s.rows.iter().zip(&s.rests) {
+            let (a, b) = (row.a as usize, row.b as usize);
+            let n = row.n;
+            let depth = rest.depth - (s.shift[b] - s.shift[a]).dot(n);
+            let slop = SLOP * rest.scale;
+            deepest = deepest.max(depth - 3.0 * slop);
+            let fix = (POSITION_SHARE * (depth - slop)).min(LARGEST_CORRECTION * rest.scale);
+            if fix > 0.0 {
+                let push = fix * row.k;
+                s.shift[a] -= n * (push * s.bodies[a].inv_mass);
+                s.shift[b] += n * (push * s.bodies[b].inv_mass);
+            }
+        }
+        if deepest <= 0.0 {
+            break;
+        }
+    }
+
+    // 5. Back to the critters; the events get their impulses.
+    for (row, rest) in s.rows.iter().zip(&s.rests) {
+        if let Some(event) = state
+            .events
+            .collisions
+            .get_mut(first_event + rest.event as usize)
+        {
+            event.impulse = row.impulse;
+        }
+    }
+    // The impulses kept for the next step's warm start, in key order: the rows were built
+    // from two runs in key order (disk pairs, then wall pairs), merged here.
+    let impulses: Vec<f64> = state.events.collisions[first_event..]
+        .iter()
+        .map(|e| e.impulse)
+        .collect();
+    // Pairs of sleepers (or of a sleeper and a wall) had no row: their impulses are kept
+    // as they were, for when the island wakes.
+    let still = sleep.still();
+    let both_still = |&&(key, _): &&(u64, f64)| {
+        let (lo, hi) = unpair_key(key);
+        let still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
+        still(lo) && still(hi)
+    };
+    let asleep: Vec<(u64, f64)> = match still.is_empty() {
+        true => Vec::new(),
+        false => s.warm.iter().filter(both_still).copied().collect(),
+    };
+    s.warm.clear();
+    let split = s
+        .keys
+        .windows(2)
+        .position(|w| w[1] < w[0])
+        .map_or(s.keys.len(), |i| i + 1);
+    let (mut i, mut j) = (0, split);
+    while i < split || j < s.keys.len() {
+        let take_first = j == s.keys.len() || (i < split && s.keys[i] < s.keys[j]);
+        let k = if take_first { &mut i } else { &mut j };
+        if impulses[*k] > 0.0 {
+            s.warm.push((s.keys[*k], impulses[*k]));
+        }
+        *k += 1;
+    }
+    if !asleep.is_empty() {
+        let solved = std::mem::take(&mut s.warm);
+        s.warm = merge_by_key(&solved, &asleep);
+    }
+    if !s.rows.is_empty() {
+        let slots = state.critters.slots_mut_moving().iter_mut().enumerate();
+        for (i, c) in slots.filter_map(|(i, c)| Some((i, c.as_mut()?))) {
+            if s.bodies[i].inv_mass > 0.0 {
+                c.vel = s.bodies[i].vel;
+                c.pos = s.pos[i] + s.shift[i];
+            }
+        }
+    }
+    // The hooks or the position sweeps may have pushed a critter across the edge.
+    state.wrap_positions();
+    if sleep.active {
+        let speed = crate::method::sleep::SLEEP_SPEED_STEPS * state.gravity.length() * dt;
+        sleep.after_solve(state.critters.slots_mut_moving(), &pairs.contacts, speed);
+    }
+    Ok(handled + s.rows.len())
+}
+
+/// Calls `caller`'s own `collide` on the pair (counted in `handled` when it touched), or
+/// keeps the pair for the solve when the caller's kind has none.
+fn hook_or_keep<V: Vector>(
+    state: &mut State<V>,
+    sleep: &mut Sleep<V>,
+    caller: u32,
+    arg: u32,
+    plain: &mut Vec<(u32, u32)>,
+    handled: &mut usize,
+) -> Result<(), Error> {
+    if !own_collide(state, caller) {
+        plain.push((caller, arg));
+        return Ok(());
+    }
+    sleep.stir(caller, arg);
+    if state.collide_pair(caller, arg)? {
+        *handled += 1;
+    }
+    Ok(())
+}
+
+/// True when `slot`'s kind has its own `collide` hook.
+fn own_collide<V: Vector>(state: &State<V>, slot: u32) -> bool {
+    state
+        .critters
+        .slot(slot)
+        .is_some_and(|c| state.kinds.get(c.kind()).has_collide)
 }
 
 /// Two lists ascending by key, with no key in both, merged.

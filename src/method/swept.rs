@@ -13,16 +13,20 @@
 //! A step in which no critter moves more than [`SWEEP_FRACTION`] of the smallest radius (or of
 //! the thinnest wall) is exactly the discrete step: sweeping is paid for only when needed.
 
+use super::discrete::{self, Respond};
+use super::flight;
 use crate::error::Error;
 use crate::vector::Vector;
-use crate::world::{StepStats, World};
+use crate::world::stages::pairs::Pairs;
+use crate::world::state::State;
+use crate::world::stats::StepStats;
 
 /// A step is swept when some critter moves more than this fraction of the smallest disk radius
 /// or wall thickness.
 pub const SWEEP_FRACTION: f64 = 0.25;
 
 /// How far disk `c` moves in the coming step (the free ones after gravity's kick).
-pub(crate) fn displacement<V: Vector>(world: &World<V>, c: &crate::critter::Critter<V>) -> f64 {
+pub(crate) fn displacement<V: Vector>(world: &State<V>, c: &crate::critter::Critter<V>) -> f64 {
     let (g, dt) = (world.gravity, world.dt);
     let v = if c.fixed { c.vel } else { c.vel + g * dt };
     v.length() * dt
@@ -49,7 +53,7 @@ impl MotionScale {
 
 /// The largest displacement of a critter in the coming step, and the lengths it must be compared
 /// with (smallest disk radius, thinnest wall).
-pub fn motion_scale<V: Vector>(world: &World<V>) -> MotionScale {
+pub(crate) fn motion_scale<V: Vector>(world: &State<V>) -> MotionScale {
     let mut scale = MotionScale {
         fastest: 0.0,
         thinnest_wall: f64::INFINITY,
@@ -79,7 +83,7 @@ pub fn motion_scale<V: Vector>(world: &World<V>) -> MotionScale {
 }
 
 /// How many live disks move more than `limit` in the coming step, and how many there are.
-pub fn count_fast<V: Vector>(world: &World<V>, limit: f64) -> (usize, usize) {
+pub(crate) fn count_fast<V: Vector>(world: &State<V>, limit: f64) -> (usize, usize) {
     let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
     let (mut fast, mut all) = (0, 0);
     for c in disks {
@@ -89,48 +93,40 @@ pub fn count_fast<V: Vector>(world: &World<V>, limit: f64) -> (usize, usize) {
     (fast, all)
 }
 
-/// One swept step (after the update hooks, before the lifecycle).
-pub fn step<V: Vector>(world: &mut World<V>, stats: &mut StepStats) -> Result<(), Error> {
-    sweep(world, stats, false)
-}
-
-/// The swept step as `auto` takes it: the same events, but a slow critter (moving less than
-/// [`SWEEP_FRACTION`] of the smallest radius or wall thickness) that can meet nothing along its
-/// line this step (no disk, wall or border within reach of both) makes no prediction; it joins
-/// in when a collision changes its flight. A few bullets among many spread-out slow critters
-/// then cost the bullets' predictions, not everyone's.
-pub fn step_where_needed<V: Vector>(
-    world: &mut World<V>,
-    stats: &mut StepStats,
-) -> Result<(), Error> {
-    sweep(world, stats, true)
-}
-
-fn sweep<V: Vector>(
-    world: &mut World<V>,
-    stats: &mut StepStats,
+/// One swept step (after the update hooks, before the lifecycle). With `fast_only`, the step
+/// as `auto` takes it: the same events, but a slow critter (moving less than [`SWEEP_FRACTION`]
+/// of the smallest radius or wall thickness) that can meet nothing along its line this step (no
+/// disk, wall or border within reach of both) makes no prediction; it joins in when a collision
+/// changes its flight. A few bullets among many spread-out slow critters then cost the bullets'
+/// predictions, not everyone's.
+pub(crate) fn step<V: Vector>(
+    state: &mut State<V>,
+    pairs: &mut Pairs<V>,
+    flight: &mut flight::Scratch<V>,
     fast_only: bool,
+    stats: &mut StepStats,
 ) -> Result<(), Error> {
-    let scale = motion_scale(world);
+    let scale = motion_scale(state);
     let limit = SWEEP_FRACTION * scale.smallest();
+    let dt = state.dt;
     if scale.fastest <= limit {
-        return world.substeps(world.dt, 1, None, stats);
+        return discrete::substeps(state, pairs, &mut Respond::Pop, dt, 1, stats);
     }
     let clock = std::time::Instant::now();
-    let dv = world.gravity * world.dt;
-    for c in world.critters.iter_mut_moving() {
+    let dv = state.gravity * dt;
+    for c in state.critters.iter_mut_moving() {
         if c.alive && !c.fixed && !c.is_wall() {
             c.vel += dv;
         }
     }
     let fast = fast_only.then_some(limit);
-    let stopped = crate::method::flight::run(world, V::zero(), world.dt, fast, false, stats)?;
+    let stopped = flight::run(state, flight, V::zero(), dt, fast, false, stats)?;
     stats.response += clock.elapsed();
     match stopped {
-        None => world.discrete_collide(stats),
+        None => discrete::collide(state, pairs, &mut Respond::Pop, dt, None, stats),
         Some(at) => {
             stats.budget_exceeded += 1;
-            finish_in_substeps(world, world.dt - at, limit, true, stats)
+            finish_in_substeps(state, pairs, dt - at, limit, true, stats)
         }
     }
 }
@@ -141,7 +137,8 @@ fn sweep<V: Vector>(
 /// [`MOST_TAIL_SUBSTEPS`] of them. `kicked`: the step gave gravity's kick for the whole step up
 /// front (swept), and the rest's part of it is taken back first, since the substeps give it.
 pub(crate) fn finish_in_substeps<V: Vector>(
-    world: &mut World<V>,
+    world: &mut State<V>,
+    pairs: &mut Pairs<V>,
     rest: f64,
     limit: f64,
     kicked: bool,
@@ -160,7 +157,7 @@ pub(crate) fn finish_in_substeps<V: Vector>(
     let n = (fastest * rest / limit)
         .ceil()
         .clamp(1.0, f64::from(MOST_TAIL_SUBSTEPS));
-    world.substeps(rest, n as u32, None, stats)
+    discrete::substeps(world, pairs, &mut Respond::Pop, rest, n as u32, stats)
 }
 
 /// The most discrete substeps that finish a swept or event step whose event budget ran out.

@@ -375,22 +375,11 @@ fn stats(
     for (stage, d) in [
         ("update", t.update),
         ("move", t.moving),
-        ("broad phase", t.broad_phase),
-        ("rules", t.rules),
-        ("narrow phase", t.narrow_phase),
+        ("pairs", t.pairs),
         ("response", t.response),
         ("lifecycle", t.lifecycle),
         ("total", t.total()),
     ] {
-        if stage == "rules" {
-            // See `StepStats::rules`.
-            writeln!(
-                out,
-                "  {stage:<12} {:.4} (steps with a rule to compute; else in the narrow phase)",
-                per(d)
-            )?;
-            continue;
-        }
         writeln!(out, "  {stage:<12} {:.4}", per(d))?;
     }
     if let Some(r) = recording {
@@ -401,21 +390,22 @@ fn stats(
             100.0 * r.as_secs_f64() / t.total().as_secs_f64().max(1e-12)
         )?;
     }
-    let rebuilds = world.broad_phase_rebuilds();
-    let grid_steps = world.broad_phase_grid_steps();
+    let diagnostics = world.diagnostics();
+    let rebuilds = diagnostics.list_rebuilds;
+    let grid_steps = diagnostics.grid_steps;
     if rebuilds > 0 {
         writeln!(
             out,
             "pair list    rebuilt {rebuilds} times (every {:.1} steps), mended {} times",
             steps.saturating_sub(grid_steps) as f64 / rebuilds as f64,
-            world.broad_phase_repairs()
+            diagnostics.list_repairs
         )?;
     }
-    if world.layouts() > 0 {
+    if diagnostics.layouts > 0 {
         writeln!(
             out,
             "layout       the critters laid out along the grid {} (docs/ARCHITECTURE.md, \"Ids and slots\")",
-            match world.layouts() {
+            match diagnostics.layouts {
                 1 => "once".to_string(),
                 n => format!("{n} times"),
             }

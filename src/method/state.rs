@@ -1,0 +1,208 @@
+//! The collision method of a world and what the methods keep between steps: the event flight,
+//! the solve's warm starts and who sleeps. The world holds one [`MethodState`] and names none of
+//! its parts; each method is handed the world's state and pair lists explicitly.
+
+use super::auto::{self, Why};
+use super::discrete::{self, Respond};
+use super::solve::{self, Sweeps};
+use super::{event, flight, sleep::Sleep, swept, Method};
+use crate::border::Topology;
+use crate::critter::Critter;
+use crate::error::Error;
+use crate::vector::Vector;
+use crate::world::stages::pairs::Pairs;
+use crate::world::state::State;
+use crate::world::stats::StepStats;
+
+/// The method and its state between steps.
+pub(crate) struct MethodState<V: Vector> {
+    /// The method asked for.
+    method: Method,
+    /// What `auto` chose for the last step, and why.
+    auto_choice: Option<(Method, Why)>,
+    pub(super) flight: flight::Scratch<V>,
+    solve: solve::Scratch<V>,
+    sleep: Sleep<V>,
+}
+
+/// What a step is taken with (under `auto`, what it chose for this step).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Plan {
+    pub(crate) method: Method,
+    /// A swept step taken per critter.
+    per_critter: bool,
+    /// Substeps of a solved step.
+    substeps: u32,
+    /// `auto`'s sweeps for a solved step.
+    sweeps: Option<Sweeps>,
+}
+
+impl<V: Vector> MethodState<V> {
+    pub(crate) fn new(method: Method, sleep: bool) -> Self {
+        MethodState {
+            method,
+            auto_choice: None,
+            flight: Default::default(),
+            solve: Default::default(),
+            sleep: Sleep::new(sleep),
+        }
+    }
+
+    pub(crate) fn method(&self) -> Method {
+        self.method
+    }
+
+    pub(crate) fn set_method(&mut self, method: Method) {
+        self.method = method;
+    }
+
+    pub(crate) fn auto_choice(&self) -> Option<(Method, Why)> {
+        self.auto_choice
+    }
+
+    /// The method for the coming step: the one asked for, or what `auto` chooses for `state`.
+    pub(crate) fn plan(&mut self, state: &State<V>) -> Plan {
+        match self.method {
+            Method::Auto => {
+                let choice = auto::choose(state, &self.flight, self.sleep.count());
+                self.auto_choice = Some((choice.method, choice.why));
+                Plan {
+                    method: choice.method,
+                    per_critter: choice.per_critter,
+                    substeps: choice.substeps,
+                    sweeps: Some(choice.sweeps),
+                }
+            }
+            method => Plan {
+                method,
+                per_critter: false,
+                substeps: 1,
+                sweeps: None,
+            },
+        }
+    }
+
+    /// True when `plan` keeps no state by slot between steps, so the critters may be laid out
+    /// anew in memory (see `world::layout`).
+    pub(crate) fn allows_layout(&self, plan: &Plan) -> bool {
+        let slot_free = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
+        slot_free(self.method) && slot_free(plan.method)
+    }
+
+    /// Moves and collides the critters over the step under `plan` (after the update hooks,
+    /// before the lifecycle).
+    pub(crate) fn step(
+        &mut self,
+        plan: Plan,
+        state: &mut State<V>,
+        pairs: &mut Pairs<V>,
+        stats: &mut StepStats,
+    ) -> Result<(), Error> {
+        let solving = matches!(plan.method, Method::Solve(_));
+        if !solving {
+            self.solve.warm.clear(); // kept only from one solve step to the next
+        }
+        self.sleep.active = solving && !self.sleep.off && state.gravity != V::zero();
+        if self.sleep.active {
+            self.sleep.check(state.critters.slot_slice());
+        } else {
+            self.sleep.clear();
+        }
+        let dt = state.dt;
+        match plan.method {
+            Method::Discrete | Method::Auto => {
+                discrete::substeps(state, pairs, &mut Respond::Pop, dt, 1, stats)
+            }
+            Method::Substep(n) => {
+                discrete::substeps(state, pairs, &mut Respond::Pop, dt, n.max(1), stats)
+            }
+            Method::Swept => swept::step(state, pairs, &mut self.flight, plan.per_critter, stats),
+            Method::Event => event::step(state, pairs, &mut self.flight, stats),
+            Method::Solve(n) => {
+                let mut respond = Respond::Solve {
+                    scratch: &mut self.solve,
+                    sleep: &mut self.sleep,
+                    sweeps: plan.sweeps.unwrap_or(Sweeps::Fixed(n)),
+                };
+                discrete::substeps(state, pairs, &mut respond, dt, plan.substeps, stats)
+            }
+        }
+    }
+
+    /// Forgets everything kept between steps (the world was put in a recorded state).
+    pub(crate) fn forget(&mut self) {
+        self.auto_choice = None;
+        self.flight = Default::default();
+        self.solve = Default::default();
+        self.sleep.forget();
+    }
+
+    /// The collision virial of the last event or swept step (see
+    /// [`crate::World::collision_virial`]).
+    pub(crate) fn collision_virial(&self) -> f64 {
+        self.flight.virial
+    }
+
+    // ----- sleep ------------------------------------------------------------------------------
+
+    /// Lets critters sleep under `solve:n`, or keeps every one awake (and wakes the sleepers).
+    pub(crate) fn set_sleep(&mut self, on: bool) {
+        self.sleep.off = !on;
+        if !on {
+            self.sleep.clear();
+        }
+    }
+
+    pub(crate) fn sleep_allowed(&self) -> bool {
+        !self.sleep.off
+    }
+
+    pub(crate) fn is_asleep(&self, slot: u32) -> bool {
+        self.sleep.asleep(slot as usize)
+    }
+
+    pub(crate) fn sleepers(&self) -> usize {
+        self.sleep.count()
+    }
+
+    /// True when removals must be reported to [`Self::removed`] (sleepers may rest on them).
+    pub(crate) fn watches_removals(&self) -> bool {
+        self.sleep.active
+    }
+
+    /// The critters of `gone` (slot, position, radius) were removed: what rested on them wakes.
+    pub(crate) fn removed(
+        &mut self,
+        topo: &Topology<V>,
+        gone: &[(usize, V, f64)],
+        slots: &[Option<Critter<V>>],
+    ) {
+        self.sleep.removed(topo, gone, slots);
+    }
+
+    /// Quiet steps and island by slot, for the slots whose count is not 0.
+    pub(crate) fn quiet_counts(&self) -> impl Iterator<Item = (usize, u16, u32)> + '_ {
+        self.sleep.counts()
+    }
+
+    /// Restores recorded counts of quiet steps, as (slot, count, island) in ascending slots.
+    pub(crate) fn restore_quiet_counts(
+        &mut self,
+        list: &[(u32, u16, u32)],
+        slots: &[Option<Critter<V>>],
+    ) -> Result<(), String> {
+        self.sleep.restore(list, slots)
+    }
+
+    // ----- the solve's warm starts ------------------------------------------------------------
+
+    /// The last solve's impulses by pair key, ascending.
+    pub(crate) fn warm_impulses(&self) -> &[(u64, f64)] {
+        &self.solve.warm
+    }
+
+    /// Restores recorded impulses by pair key, ascending.
+    pub(crate) fn set_warm_impulses(&mut self, warm: Vec<(u64, f64)>) {
+        self.solve.warm = warm;
+    }
+}

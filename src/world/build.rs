@@ -1,0 +1,227 @@
+//! Building a world: kinds, walls, spawns and removals, each checked, so a bad spawn is an
+//! error naming the critter and the field, and nothing is added then.
+
+use super::state::State;
+use super::{fmt_vec, World};
+use crate::contact::contact_wall_ball;
+use crate::critter::{
+    check_positive, check_restitution, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET,
+    CP_WALL,
+};
+use crate::error::Error;
+use crate::kind::{KindDefaults, KindHooks, KindId, WALL};
+use crate::vector::Vector;
+use crate::wall::WallBox;
+use std::rc::Rc;
+use std::sync::Arc;
+
+impl<V: Vector> World<V> {
+    /// Registers a kind (see [`KindSet::register`]).
+    pub fn register_kind(
+        &mut self,
+        name: &str,
+        parent: Option<&str>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Result<KindId, Error> {
+        self.state.kinds.register(name, parent, defaults, hooks)
+    }
+
+    /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
+    pub fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
+        self.state.add_wall(wall)
+    }
+
+    /// Makes room for `additional` more critters, exactly (for a scene that knows how many it
+    /// will spawn: the critters' storage then does not grow by doubling).
+    pub fn reserve(&mut self, additional: usize) {
+        self.state.critters.reserve(additional);
+    }
+
+    /// Spawns a critter now. Errors name the critter and the bad field; nothing is added then.
+    pub fn spawn(&mut self, spec: CritterSpec<V>) -> Result<CritterId, Error> {
+        self.state.spawn(spec)
+    }
+
+    /// Adds a line to the current step's log (scene scripts between steps).
+    pub fn log_line(&mut self, line: String) {
+        self.state.events.log.push(line);
+    }
+
+    /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
+    pub fn remove(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
+        let state = &mut self.state;
+        let slot = state.critters.slot_of(id).ok_or(Error::NoSuchCritter(id))?;
+        let c = state.critters.remove(id).ok_or(Error::NoSuchCritter(id))?;
+        if c.is_wall() {
+            state.walls.retain(|&w| w != id);
+        }
+        // What rested on it wakes.
+        let gone = [(slot as usize, c.pos, c.radius)];
+        self.methods
+            .removed(&state.topo, &gone, state.critters.slot_slice());
+        Ok(c)
+    }
+}
+
+impl<V: Vector> State<V> {
+    /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
+    pub(crate) fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
+        wall.validate()?;
+        let center = wall.center;
+        let radius = wall.bounding_radius();
+        let id = self.critters.insert(|id| Critter {
+            id,
+            class: CLASS_UNSET,
+            pos: center,
+            vel: V::zero(),
+            radius,
+            _align: [],
+            fixed: true,
+            alive: true,
+            wall: true,
+            traits: Arc::new(Traits {
+                kind: WALL,
+                mass: f64::INFINITY,
+                priority: CP_WALL,
+                restitution: 1.0,
+                health: 1.0,
+                shape: Shape::Wall(Box::new(wall)),
+                props: Default::default(),
+            }),
+        });
+        self.walls.push(id);
+        Ok(id)
+    }
+
+    /// Spawns a critter now. Errors name the critter and the bad field; nothing is added then.
+    pub(crate) fn spawn(&mut self, spec: CritterSpec<V>) -> Result<CritterId, Error> {
+        let critter = self.build(spec)?;
+        let has_init = self.kinds.get(critter.kind()).has_init;
+        let id = self.critters.insert(|id| Critter { id, ..critter });
+        if has_init {
+            self.run_init(id)?;
+        }
+        Ok(id)
+    }
+
+    /// The critter `spec` asks for, checked: errors name the critter and the bad field.
+    fn build(&self, spec: CritterSpec<V>) -> Result<Critter<V>, Error> {
+        let kind_id = self.kinds.id(&spec.kind)?;
+        if kind_id == WALL {
+            return Err(Error::InvalidKind {
+                kind: spec.kind,
+                reason: "walls are added with add_wall (they need a box, not a radius)".into(),
+            });
+        }
+        let kind = self.kinds.get(kind_id);
+        let d = &kind.defaults;
+        let who = || format!("the {} spawned at {}", spec.kind, fmt_vec(spec.pos));
+        if !spec.pos.all_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who(),
+                field: "position",
+                value: format!("{:?}", spec.pos),
+                reason: "every coordinate must be a finite number".into(),
+            });
+        }
+        for axis in 0..V::DIM {
+            let x = spec.pos.get(axis);
+            if x < self.topo.min.get(axis) || x > self.topo.max.get(axis) {
+                return Err(Error::InvalidCritter {
+                    critter: who(),
+                    field: "position",
+                    value: fmt_vec(spec.pos),
+                    reason: format!(
+                        "outside the world box {} to {}",
+                        fmt_vec(self.topo.min),
+                        fmt_vec(self.topo.max)
+                    ),
+                });
+            }
+        }
+        if !spec.vel.all_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who(),
+                field: "velocity",
+                value: format!("{:?}", spec.vel),
+                reason: "every component must be a finite number".into(),
+            });
+        }
+        let radius = spec.radius.unwrap_or(d.radius);
+        check_positive(who, "radius", radius)?;
+        let density = spec.density.unwrap_or(d.density);
+        check_positive(who, "density", density)?;
+        let mass = spec
+            .mass
+            .or(if spec.density.is_some() { None } else { d.mass });
+        let mass = mass.unwrap_or(density * radius * radius * radius);
+        check_positive(who, "mass", mass)?;
+        let restitution = spec.restitution.unwrap_or(d.restitution);
+        check_restitution(who, restitution)?;
+        let priority = spec.priority.unwrap_or(d.priority);
+        if !priority.is_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who(),
+                field: "priority",
+                value: priority.to_string(),
+                reason: "must be a finite number; use the CP_* constants".into(),
+            });
+        }
+        let health = spec.health.unwrap_or(d.health);
+        if !health.is_finite() {
+            return Err(Error::InvalidCritter {
+                critter: who(),
+                field: "health",
+                value: health.to_string(),
+                reason: "must be a finite number".into(),
+            });
+        }
+        for &wall_id in &self.walls {
+            let Some(wall) = self.critters.get(wall_id) else {
+                continue;
+            };
+            let Shape::Wall(geom) = wall.shape() else {
+                continue;
+            };
+            let d = self.topo.delta(wall.pos, spec.pos);
+            if let Some(c) = contact_wall_ball(geom, d, radius) {
+                if c.depth > 1e-9 * radius.max(1.0) {
+                    return Err(Error::SpawnInsideWall {
+                        critter: who(),
+                        wall: wall_id,
+                        depth: c.depth,
+                    });
+                }
+            }
+        }
+        let fixed = spec.fixed.unwrap_or(d.fixed);
+        Ok(Critter {
+            id: CritterId {
+                index: 0,
+                generation: 0,
+            },
+            class: CLASS_UNSET,
+            pos: spec.pos,
+            vel: spec.vel,
+            radius,
+            _align: [],
+            fixed,
+            alive: true,
+            wall: false,
+            traits: Arc::new(Traits {
+                kind: kind_id,
+                mass,
+                priority,
+                restitution,
+                health,
+                shape: Shape::Disk,
+                props: {
+                    let mut props = d.props.clone();
+                    props.extend(spec.props);
+                    props
+                },
+            }),
+        })
+    }
+}

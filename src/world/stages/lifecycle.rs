@@ -1,0 +1,35 @@
+//! The lifecycle stage: the critters that died in the step are removed (and what rested on
+//! them wakes), then the spawns the hooks queued are added.
+
+use crate::error::Error;
+use crate::method::state::MethodState;
+use crate::vector::Vector;
+use crate::world::state::State;
+
+/// Removes the step's dead and adds its queued spawns.
+pub(crate) fn run<V: Vector>(
+    state: &mut State<V>,
+    methods: &mut MethodState<V>,
+) -> Result<(), Error> {
+    let mut gone = Vec::new();
+    for id in std::mem::take(&mut state.pending.deaths) {
+        state.events.deaths.push(id);
+        let slot = state.critters.slot_of(id);
+        if let (Some(slot), Some(c)) = (slot, state.critters.remove(id)) {
+            if c.is_wall() {
+                state.walls.retain(|&w| w != id);
+            }
+            if methods.watches_removals() {
+                gone.push((slot as usize, c.pos, c.radius));
+            }
+        }
+    }
+    if !gone.is_empty() {
+        methods.removed(&state.topo, &gone, state.critters.slot_slice());
+    }
+    for spec in std::mem::take(&mut state.pending.spawns) {
+        let id = state.spawn(spec)?;
+        state.events.spawns.push(id);
+    }
+    Ok(())
+}

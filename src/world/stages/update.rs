@@ -1,0 +1,37 @@
+//! The update stage: each live critter whose kind has an `update` hook runs it, in id order
+//! wherever the critters are stored.
+
+use crate::context::UpdateCtx;
+use crate::error::Error;
+use crate::vector::Vector;
+use crate::world::state::{hook_error, State};
+
+/// Runs the `update` hooks of the step.
+pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
+    if !state.kinds.iter().any(|(_, k)| k.has_update) {
+        return Ok(());
+    }
+    let dt = state.dt;
+    let step = state.step_count;
+    for index in 0..state.critters.index_count() as u32 {
+        let Some(slot) = state.critters.slot_of_index(index) else {
+            continue;
+        };
+        let Some(c) = state.critters.slot(slot) else {
+            continue;
+        };
+        if !c.alive || !state.kinds.get(c.kind()).has_update {
+            continue;
+        }
+        let (kind, id) = (c.kind(), c.id);
+        let hooks = state.kinds.get(kind).hooks.clone();
+        let mut ctx = UpdateCtx {
+            access: state.access(),
+            me: slot,
+        };
+        hooks
+            .update(&mut ctx, dt)
+            .map_err(|e| hook_error(e, &state.kinds, kind, id, step))?;
+    }
+    Ok(())
+}

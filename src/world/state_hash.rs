@@ -1,0 +1,49 @@
+//! The state hash: one 64-bit word over the raw bits of everything a step depends on, so equal
+//! hashes mean bit-identical worlds. Recordings write it every step; replays compare it.
+
+use super::World;
+use crate::hash::{StateHasher, LANES};
+use crate::vector::Vector;
+
+impl<V: Vector> World<V> {
+    /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
+    /// overwhelming probability) bit-identical worlds. It covers the step count, dt, the
+    /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
+    /// radius, mass, priority, restitution, health and properties, and under `solve:n` the
+    /// critters' counts of quiet steps towards sleep.
+    pub fn state_hash(&self) -> u64 {
+        self.state_hash_and_totals().0
+    }
+
+    /// [`World::state_hash`], [`World::kinetic_energy`] and [`World::momentum`] (the same bits)
+    /// from one pass over the critters, so a recorder walks them once.
+    pub fn state_hash_and_totals(&self) -> (u64, f64, V) {
+        let mut h = StateHasher::default();
+        h.word(self.state.step_count);
+        h.float(self.state.dt);
+        for w in self.state.rng.state() {
+            h.word(w);
+        }
+        // Every critter's fields in lanes (src/critter_hash.rs), the rarely changing ones reused
+        // from the last hash when nothing could have written them; properties go to a hasher of
+        // their own, after their owner's id.
+        const _: () = assert!(crate::critter_hash::LANES.is_multiple_of(LANES));
+        let pass = crate::critter_hash::hash_critters(
+            self.state.critters.in_id_order(),
+            self.state.critters.statics(),
+        );
+        for half in pass.lanes.chunks_exact(LANES) {
+            let mut w = [0u64; LANES];
+            w.copy_from_slice(half);
+            h.words(w);
+        }
+        h.word(pass.props);
+        // The quiet steps, when there are any (a world without them hashes as it did before
+        // sleep existed).
+        for (slot, q, island) in self.methods.quiet_counts() {
+            h.word((slot as u64) << 16 | u64::from(q));
+            h.word(u64::from(island));
+        }
+        (h.finish(), pass.energy, pass.momentum)
+    }
+}

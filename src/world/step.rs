@@ -1,0 +1,59 @@
+//! The step, as a recipe of named stages (see the module docs of [`crate::world`]).
+
+use super::stages::{lifecycle, update};
+use super::stats::{timed, StepStats};
+use super::World;
+use crate::error::Error;
+use crate::vector::Vector;
+
+impl<V: Vector> World<V> {
+    /// Advances the world by one time step: update hooks, the collision method's move, pairs
+    /// and response, then deaths and spawns.
+    ///
+    /// An error from a hook or a bad queued spawn stops the step where it happened; the world is
+    /// then part-way through that step.
+    pub fn step(&mut self) -> Result<(), Error> {
+        self.state.events.clear();
+        self.stats = StepStats::default();
+        let mut stats = StepStats::default();
+
+        timed(&mut stats.update, || update::run(&mut self.state))?;
+        let plan = self.methods.plan(&self.state);
+        // The layout is for the broad phase's sake, which rebuilds its list after one.
+        let allowed = self.methods.allows_layout(&plan);
+        timed(&mut stats.pairs, || {
+            self.layout
+                .lay_out(&mut self.state, &mut self.pairs.broad, allowed)
+        });
+        self.methods
+            .step(plan, &mut self.state, &mut self.pairs, &mut stats)?;
+        timed(&mut stats.lifecycle, || {
+            lifecycle::run(&mut self.state, &mut self.methods)
+        })?;
+
+        self.finish_step(stats);
+        Ok(())
+    }
+
+    /// Runs `n` steps.
+    pub fn run(&mut self, n: u64) -> Result<(), Error> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// The step's figures kept and added to the totals; the step is counted.
+    fn finish_step(&mut self, mut stats: StepStats) {
+        stats.impacts = self
+            .state
+            .events
+            .collisions
+            .iter()
+            .filter(|e| e.impulse > 0.0)
+            .count();
+        self.stats = stats;
+        self.totals.add(&stats);
+        self.state.step_count += 1;
+    }
+}
