@@ -38,9 +38,7 @@ fn assert_spawn_rejected(world: &mut World<DVec2>, spec: CritterSpec<DVec2>, fie
 
 fn world_with_kind() -> World<DVec2> {
     let mut world = world2(10.0);
-    world
-        .register_kind("mole", None, KindDefaults::default(), Rc::new(()))
-        .unwrap();
+    register(&mut world, "mole", KindDefaults::default(), Rc::new(()));
     world
 }
 
@@ -445,13 +443,12 @@ impl KindHooks<DVec2> for BadSpawner {
 #[test]
 fn bad_spawn_queued_by_a_hook_fails_the_step_with_the_field_named() {
     let mut world = world2(10.0);
-    let d = KindDefaults {
-        priority: CP_PLAYER,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("bad", None, d, Rc::new(BadSpawner))
-        .unwrap();
+    register(
+        &mut world,
+        "bad",
+        with_priority(CP_PLAYER),
+        Rc::new(BadSpawner),
+    );
     world
         .spawn(CritterSpec::new("bad", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -478,13 +475,12 @@ impl KindHooks<DVec2> for Failing {
 #[test]
 fn failing_hook_is_an_error_naming_the_kind_and_critter() {
     let mut world = world2(10.0);
-    let d = KindDefaults {
-        priority: CP_PLAYER,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("failing", None, d, Rc::new(Failing))
-        .unwrap();
+    register(
+        &mut world,
+        "failing",
+        with_priority(CP_PLAYER),
+        Rc::new(Failing),
+    );
     let f = world
         .spawn(CritterSpec::new("failing", DVec2::new(5.0, 5.0)))
         .unwrap();

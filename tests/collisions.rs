@@ -123,25 +123,25 @@ fn check_elastic<V: Vector>(o: &Outcome<V>, label: &str) {
     assert_close(
         o.v1.dot(n),
         want1,
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: caller normal velocity"),
     );
     assert_close(
         o.v2.dot(n),
         want2,
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: arg normal velocity"),
     );
     assert_close_vec(
         tangential(o.v1, n),
         tangential(o.a.vel, n),
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: caller tangential velocity"),
     );
     assert_close_vec(
         tangential(o.v2, n),
         tangential(o.b.vel, n),
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: arg tangential velocity"),
     );
     check_momentum(o, label);
@@ -155,12 +155,12 @@ fn check_elastic<V: Vector>(o: &Outcome<V>, label: &str) {
     assert_close(
         o.impulse,
         measured,
-        1e-12 * m1.min(m2) * vscale,
+        ROUND_OFF * m1.min(m2) * vscale,
         &format!("{label}: impulse"),
     );
     let rel = (o.energy_after - o.energy_before).abs() / o.energy_before;
     assert!(
-        rel <= 1e-12,
+        rel <= ROUND_OFF,
         "{label}: kinetic energy changed by {rel:e} (relative) in an elastic hit"
     );
     check_separation(o, label);
@@ -171,14 +171,14 @@ fn check_momentum<V: Vector>(o: &Outcome<V>, label: &str) {
     assert_close_vec(
         o.momentum_after,
         o.momentum_before,
-        1e-14 * scale,
+        MOMENTUM_ROUND_OFF * scale,
         &format!("{label}: momentum"),
     );
     // The world's sum agrees with the bodies' own.
     assert_close_vec(
         o.momentum_after,
         o.v1 * o.a.mass + o.v2 * o.b.mass,
-        1e-15 * scale,
+        FEW_ULPS * scale,
         &format!("{label}: world momentum is the sum of m v"),
     );
 }
@@ -190,7 +190,7 @@ fn check_separation<V: Vector>(o: &Outcome<V>, label: &str) {
     assert_close(
         dist,
         o.a.radius + o.b.radius,
-        1e-12,
+        ROUND_OFF,
         &format!("{label}: distance after separation"),
     );
     let com_before = (o.q1 * m1 + o.q2 * m2) * (1.0 / (m1 + m2));
@@ -198,70 +198,85 @@ fn check_separation<V: Vector>(o: &Outcome<V>, label: &str) {
     assert_close_vec(
         com_after,
         com_before,
-        1e-12,
+        ROUND_OFF,
         &format!("{label}: centre of mass"),
     );
 }
 
-#[test]
-fn head_on_disks_follow_pop_elastic_formula_for_mass_ratios_1e_minus6_to_1e6() {
+/// Whether a pair meets along its line of motion or off it.
+#[derive(Clone, Copy, PartialEq)]
+enum Hit {
+    HeadOn,
+    /// Off-centre: the tangential parts are not small.
+    Glancing,
+}
+
+/// `a` (mass 1) meets `b` given each of [`MASS_RATIOS`] in turn as its mass: Pop's elastic
+/// formulas and the conservation laws hold.
+fn check_elastic_for_all_mass_ratios<V: Vector>(a: Body<V>, b: Body<V>, hit: Hit, label: &str) {
     for mr in MASS_RATIOS {
-        let a = body(DVec2::new(4.0, 5.0), DVec2::new(1.2, 0.0), 0.5, 1.0);
-        let b = body(DVec2::new(4.99, 5.0), DVec2::new(-0.7, 0.0), 0.5, mr);
-        check_elastic(&collide_pair(a, b), &format!("2D head-on, mr = {mr:e}"));
+        let label = format!("{label}, mr = {mr:e}");
+        let o = collide_pair(a, Body { mass: mr, ..b });
+        if hit == Hit::Glancing {
+            assert!(
+                tangential(a.vel, o.n).length() > 0.3 * a.vel.length(),
+                "{label}: test setup: a real glancing hit"
+            );
+        }
+        check_elastic(&o, &label);
     }
 }
 
 #[test]
-fn glancing_disks_change_only_normal_components_for_all_mass_ratios() {
-    for mr in MASS_RATIOS {
-        let a = body(DVec2::new(4.0, 5.0), DVec2::new(1.0, 0.4), 0.5, 1.0);
-        let b = body(DVec2::new(4.3, 5.8), DVec2::new(-0.3, -0.5), 0.4, mr);
-        let o = collide_pair(a, b);
-        // A real glancing hit: the tangential parts are not small.
-        assert!(tangential(a.vel, o.n).length() > 0.3 * a.vel.length());
-        check_elastic(&o, &format!("2D glancing, mr = {mr:e}"));
-    }
-}
-
-#[test]
-fn head_on_spheres_follow_pop_elastic_formula_for_all_mass_ratios() {
-    for mr in MASS_RATIOS {
-        let a = body(
+fn head_on_pairs_follow_pop_elastic_formula_for_mass_ratios_1e_minus6_to_1e6() {
+    check_elastic_for_all_mass_ratios(
+        body(DVec2::new(4.0, 5.0), DVec2::new(1.2, 0.0), 0.5, 1.0),
+        body(DVec2::new(4.99, 5.0), DVec2::new(-0.7, 0.0), 0.5, 1.0),
+        Hit::HeadOn,
+        "2D head-on",
+    );
+    check_elastic_for_all_mass_ratios(
+        body(
             DVec3::new(4.0, 5.0, 5.0),
             DVec3::new(0.0, 0.0, 1.1),
             0.5,
             1.0,
-        );
-        let b = body(
+        ),
+        body(
             DVec3::new(4.0, 5.0, 5.98),
             DVec3::new(0.0, 0.0, -0.9),
             0.5,
-            mr,
-        );
-        check_elastic(&collide_pair(a, b), &format!("3D head-on, mr = {mr:e}"));
-    }
+            1.0,
+        ),
+        Hit::HeadOn,
+        "3D head-on",
+    );
 }
 
 #[test]
-fn glancing_spheres_change_only_normal_components_for_all_mass_ratios() {
-    for mr in MASS_RATIOS {
-        let a = body(
+fn glancing_pairs_change_only_normal_components_for_all_mass_ratios() {
+    check_elastic_for_all_mass_ratios(
+        body(DVec2::new(4.0, 5.0), DVec2::new(1.0, 0.4), 0.5, 1.0),
+        body(DVec2::new(4.3, 5.8), DVec2::new(-0.3, -0.5), 0.4, 1.0),
+        Hit::Glancing,
+        "2D glancing",
+    );
+    check_elastic_for_all_mass_ratios(
+        body(
             DVec3::new(4.0, 5.0, 5.0),
             DVec3::new(0.8, 0.3, -0.2),
             0.5,
             1.0,
-        );
-        let b = body(
+        ),
+        body(
             DVec3::new(4.5, 5.6, 5.55),
             DVec3::new(-0.4, 0.1, 0.6),
             0.5,
-            mr,
-        );
-        let o = collide_pair(a, b);
-        assert!(tangential(a.vel, o.n).length() > 0.3 * a.vel.length());
-        check_elastic(&o, &format!("3D glancing, mr = {mr:e}"));
-    }
+            1.0,
+        ),
+        Hit::Glancing,
+        "3D glancing",
+    );
 }
 
 /// With e < 1 the relative normal speed after is e times before, momentum is exact, and the
@@ -280,19 +295,19 @@ fn check_restitution<V: Vector>(a: Body<V>, b: Body<V>, e: f64, label: &str) {
     assert_close(
         after,
         -e * before,
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: relative normal velocity"),
     );
     assert_close_vec(
         tangential(o.v1, n),
         tangential(a.vel, n),
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: tangential"),
     );
     assert_close_vec(
         tangential(o.v2, n),
         tangential(b.vel, n),
-        1e-12 * vscale,
+        ROUND_OFF * vscale,
         &format!("{label}: tangential"),
     );
     check_momentum(&o, label);
@@ -301,7 +316,7 @@ fn check_restitution<V: Vector>(a: Body<V>, b: Body<V>, e: f64, label: &str) {
     assert_close(
         o.energy_before - o.energy_after,
         lost,
-        1e-12 * o.energy_before,
+        ROUND_OFF * o.energy_before,
         &format!("{label}: kinetic energy lost"),
     );
     check_separation(&o, label);
@@ -329,6 +344,29 @@ fn restitution_below_one_scales_relative_normal_speed_and_keeps_momentum() {
     }
 }
 
+/// Equal masses, `b` at rest, struck off-centre by `a`: both move, at right angles, and the
+/// kinetic energy is kept.
+fn check_right_angles<V: Vector>(a: Body<V>, b: Body<V>, label: &str) {
+    let o = collide_pair(a, b);
+    let (speed, v2) = (a.vel.length(), a.vel.length_squared());
+    assert!(
+        o.v1.length() > 0.05 * speed && o.v2.length() > 0.05 * speed,
+        "{label}: both move after a glancing hit"
+    );
+    assert_close(
+        o.v1.dot(o.v2),
+        0.0,
+        ROUND_OFF * v2,
+        &format!("{label}: v1' . v2'"),
+    );
+    assert_close(
+        o.v1.length_squared() + o.v2.length_squared(),
+        v2,
+        ROUND_OFF * v2,
+        &format!("{label}: |v1'|^2 + |v2'|^2"),
+    );
+}
+
 #[test]
 fn equal_masses_in_a_glancing_hit_on_a_resting_target_leave_at_right_angles() {
     for (offset, speed) in [
@@ -338,24 +376,7 @@ fn equal_masses_in_a_glancing_hit_on_a_resting_target_leave_at_right_angles() {
     ] {
         let a = body(DVec2::new(4.0, 5.0), DVec2::new(speed, 0.0), 0.5, 0.3);
         let b = body(DVec2::new(4.0, 5.0) + offset, DVec2::ZERO, 0.5, 0.3);
-        let o = collide_pair(a, b);
-        let v2 = speed * speed;
-        assert!(
-            o.v1.length() > 0.05 * speed && o.v2.length() > 0.05 * speed,
-            "both move after a glancing hit"
-        );
-        assert_close(
-            o.v1.dot(o.v2),
-            0.0,
-            1e-12 * v2,
-            &format!("offset {offset}: v1' . v2'"),
-        );
-        assert_close(
-            o.v1.length_squared() + o.v2.length_squared(),
-            v2,
-            1e-12 * v2,
-            &format!("offset {offset}: |v1'|^2 + |v2'|^2"),
-        );
+        check_right_angles(a, b, &format!("2D, offset {offset}"));
     }
     let a = body(
         DVec3::new(4.0, 5.0, 5.0),
@@ -364,51 +385,46 @@ fn equal_masses_in_a_glancing_hit_on_a_resting_target_leave_at_right_angles() {
         2.0,
     );
     let b = body(DVec3::new(4.3, 5.8, 5.4), DVec3::ZERO, 0.5, 2.0);
-    let o = collide_pair(a, b);
-    assert_close(o.v1.dot(o.v2), 0.0, 1e-12 * 2.25, "3D: v1' . v2'");
+    check_right_angles(a, b, "3D");
+}
+
+/// A ball at `pa` moving at `v` strikes an equal ball at rest at `pb`: after one step, a line
+/// saying what went wrong unless they exchanged velocities exactly.
+fn swap_failure<V: Vector>(pa: V, pb: V, v: V, label: &str) -> Option<String> {
+    let mut world = world::<V>(10.0);
+    let a = world.spawn(CritterSpec::ball(pa).vel(v)).unwrap();
+    let b = world.spawn(CritterSpec::ball(pb)).unwrap();
+    world.step().unwrap();
+    let (va, vb) = (world.get(a).unwrap().vel, world.get(b).unwrap().vel);
+    (va != V::zero() || vb != v).then(|| format!("{label}: a {va:?}, b {vb:?}"))
 }
 
 /// Equal masses, target at rest, head on along an axis: the velocities are exchanged bit for bit.
 /// Power-of-two masses (the default density and radius 0.5 give 1/8) make every step of the
 /// impulse exact, so any difference comes from the contact normal not being exactly the axis.
 #[test]
-
 fn head_on_equal_masses_swap_velocities_exactly() {
     let mut failures = Vec::new();
     for k in 0..40 {
         for speed in [1.0, 0.7, 2.5, 1.3] {
             let x0 = 3.0 + 0.0137 * k as f64;
             let gap = 0.97 + 0.0007 * k as f64;
-            let mut world = world2(10.0);
-            let a = world
-                .spawn(CritterSpec::ball(DVec2::new(x0, 5.0)).vel(DVec2::new(speed, 0.0)))
-                .unwrap();
-            let b = world
-                .spawn(CritterSpec::ball(DVec2::new(x0 + gap, 5.0)))
-                .unwrap();
-            world.step().unwrap();
-            let (va, vb) = (world.get(a).unwrap().vel, world.get(b).unwrap().vel);
-            if va != DVec2::ZERO || vb != DVec2::new(speed, 0.0) {
-                failures.push(format!(
-                    "x0 {x0}, gap {gap}, speed {speed}: a {va:?}, b {vb:?}"
-                ));
-            }
+            failures.extend(swap_failure(
+                DVec2::new(x0, 5.0),
+                DVec2::new(x0 + gap, 5.0),
+                DVec2::new(speed, 0.0),
+                &format!("2D x0 {x0}, gap {gap}, speed {speed}"),
+            ));
         }
     }
     for k in 0..40 {
         let z0 = 3.0 + 0.0113 * k as f64;
-        let mut world = world3(10.0);
-        let a = world
-            .spawn(CritterSpec::ball(DVec3::new(5.0, 5.0, z0)).vel(DVec3::new(0.0, 0.0, 1.0)))
-            .unwrap();
-        let b = world
-            .spawn(CritterSpec::ball(DVec3::new(5.0, 5.0, z0 + 0.98)))
-            .unwrap();
-        world.step().unwrap();
-        let (va, vb) = (world.get(a).unwrap().vel, world.get(b).unwrap().vel);
-        if va != DVec3::ZERO || vb != DVec3::new(0.0, 0.0, 1.0) {
-            failures.push(format!("3D z0 {z0}: a {va:?}, b {vb:?}"));
-        }
+        failures.extend(swap_failure(
+            DVec3::new(5.0, 5.0, z0),
+            DVec3::new(5.0, 5.0, z0 + 0.98),
+            DVec3::new(0.0, 0.0, 1.0),
+            &format!("3D z0 {z0}"),
+        ));
     }
     assert!(
         failures.is_empty(),
@@ -433,85 +449,74 @@ fn head_on_equal_masses_both_moving_swap_velocities_to_round_off() {
 
 /// A fixed critter has infinite mass: a ball hitting it has its normal velocity reversed and its
 /// tangential velocity kept, and the fixed critter neither moves nor changes velocity, whichever
-/// of the two calls (even with a nominal mass equal to the ball's).
-#[test]
-fn fixed_critter_reflects_a_ball_and_does_not_move() {
+/// of the two calls. `fixed` is at rest; the ball's radius and the fixed critter's sum to 1.
+fn check_fixed_reflects<V: Vector>(fixed: CritterSpec<V>, ball: CritterSpec<V>, label: &str) {
+    let (fixed_pos, p, v) = (fixed.pos, ball.pos, ball.vel);
     for fixed_first in [true, false] {
-        let mut world = world2(10.0);
-        let fixed_pos = DVec2::new(5.0, 5.0);
-        let (p, v) = (DVec2::new(4.4, 5.7), DVec2::new(1.0, -0.5));
-        let spawn_fixed = |w: &mut World<DVec2>| {
-            w.spawn(CritterSpec::ball(fixed_pos).mass(0.2).fixed(true))
-                .unwrap()
-        };
-        let spawn_ball =
-            |w: &mut World<DVec2>| w.spawn(CritterSpec::ball(p).vel(v).mass(0.2)).unwrap();
-        let (fixed, ball) = if fixed_first {
-            let f = spawn_fixed(&mut world);
-            (f, spawn_ball(&mut world))
+        let label = format!("{label}, fixed spawned first: {fixed_first}");
+        let mut world = world::<V>(10.0);
+        let (f, b) = if fixed_first {
+            let f = world.spawn(fixed.clone()).unwrap();
+            (f, world.spawn(ball.clone()).unwrap())
         } else {
-            let b = spawn_ball(&mut world);
-            (spawn_fixed(&mut world), b)
+            let b = world.spawn(ball.clone()).unwrap();
+            (world.spawn(fixed.clone()).unwrap(), b)
         };
         let q = after_move(p, v, world.dt());
         let n = unit(q - fixed_pos); // from the fixed critter to the ball
         assert!(
             v.dot(n) < 0.0 && (q - fixed_pos).length() < 1.0,
-            "test setup"
+            "{label}: test setup"
         );
         world.step().unwrap();
-        assert_eq!(world.events().collisions.len(), 1);
-        let f = world.get(fixed).unwrap();
-        assert_eq!(f.pos, fixed_pos, "the fixed critter was moved");
-        assert_eq!(f.vel, DVec2::ZERO, "the fixed critter was given a velocity");
-        let b = world.get(ball).unwrap();
+        assert_eq!(world.events().collisions.len(), 1, "{label}: one collision");
+        let fc = world.get(f).unwrap();
+        assert_eq!(fc.pos, fixed_pos, "{label}: the fixed critter was moved");
+        assert_eq!(
+            fc.vel,
+            V::zero(),
+            "{label}: the fixed critter was given a velocity"
+        );
+        let bc = world.get(b).unwrap();
         assert_close_vec(
-            b.vel,
+            bc.vel,
             reflect(v, n),
-            1e-12,
-            "ball velocity reflected off the fixed critter",
+            ROUND_OFF,
+            &format!("{label}: ball velocity reflected off the fixed critter"),
         );
-        assert_close(b.vel.dot(n), -v.dot(n), 1e-12, "normal component reversed");
-        assert_close_vec(
-            tangential(b.vel, n),
-            tangential(v, n),
-            1e-12,
-            "tangential component kept",
-        );
+        assert_reflected(bc.vel, v, n, &label);
         // The whole overlap was taken by the ball: it now touches the fixed critter, moved along n.
         assert_close_vec(
-            b.pos,
+            bc.pos,
             fixed_pos + n * 1.0,
-            1e-12,
-            "ball pushed out along the normal",
+            ROUND_OFF,
+            &format!("{label}: ball pushed out along the normal"),
+        );
+        assert_close(
+            (bc.pos - fixed_pos).length(),
+            1.0,
+            ROUND_OFF,
+            &format!("{label}: distance after separation"),
         );
     }
 }
 
 #[test]
-fn fixed_sphere_reflects_a_sphere_and_does_not_move() {
-    let mut world = world3(10.0);
-    let c = DVec3::new(5.0, 5.0, 5.0);
-    let fixed = world.spawn(CritterSpec::ball(c).fixed(true)).unwrap();
-    let (p, v) = (DVec3::new(4.5, 5.4, 5.6), DVec3::new(0.6, -0.3, -0.9));
-    let ball = world.spawn(CritterSpec::ball(p).vel(v)).unwrap();
-    let q = after_move(p, v, world.dt());
-    let n = unit(q - c);
-    world.step().unwrap();
-    assert_eq!(world.get(fixed).unwrap().pos, c);
-    assert_eq!(world.get(fixed).unwrap().vel, DVec3::ZERO);
-    let b = world.get(ball).unwrap();
-    assert_close_vec(
-        b.vel,
-        reflect(v, n),
-        1e-12,
-        "sphere reflected off the fixed sphere",
+fn fixed_critter_reflects_a_ball_and_does_not_move() {
+    // Even with a nominal mass equal to the ball's.
+    check_fixed_reflects(
+        CritterSpec::ball(DVec2::new(5.0, 5.0))
+            .mass(0.2)
+            .fixed(true),
+        CritterSpec::ball(DVec2::new(4.4, 5.7))
+            .vel(DVec2::new(1.0, -0.5))
+            .mass(0.2),
+        "2D",
     );
-    assert_close(
-        (b.pos - c).length(),
-        1.0,
-        1e-12,
-        "distance after separation",
+    check_fixed_reflects(
+        CritterSpec::ball(DVec3::new(5.0, 5.0, 5.0)).fixed(true),
+        CritterSpec::ball(DVec3::new(4.5, 5.4, 5.6)).vel(DVec3::new(0.6, -0.3, -0.9)),
+        "3D",
     );
 }
 
@@ -547,7 +552,7 @@ fn overlapping_separating_pair_gets_no_impulse_but_is_pushed_apart() {
     assert_close(
         (cb.pos - ca.pos).length(),
         1.0,
-        1e-12,
+        ROUND_OFF,
         "pushed apart until they touch",
     );
     // Pushed along the line of centres, heavier one less (split by inverse mass: 3 to 1).
@@ -555,13 +560,13 @@ fn overlapping_separating_pair_gets_no_impulse_but_is_pushed_apart() {
     assert_close(
         d1.dot(n),
         -3.0 * d2.dot(n),
-        1e-12,
+        ROUND_OFF,
         "displacements split 3:1 by inverse mass",
     );
     assert_close(
         tangential(d1, n).length() + tangential(d2, n).length(),
         0.0,
-        1e-12,
+        ROUND_OFF,
         "pushed along the normal only",
     );
 }
@@ -582,8 +587,18 @@ fn coincident_centres_separate_along_plus_x_without_nan() {
     assert!(ca.pos.is_finite() && cb.pos.is_finite() && ca.vel.is_finite() && cb.vel.is_finite());
     assert_eq!(world.events().collisions[0].normal, DVec2::X);
     // Depth 0.8 split by inverse mass: 1 : 1/3 -> caller 0.6 back, arg 0.2 forward.
-    assert_close_vec(ca.pos, DVec2::new(5.0 - 0.6, 5.0), 1e-12, "caller position");
-    assert_close_vec(cb.pos, DVec2::new(5.0 + 0.2, 5.0), 1e-12, "arg position");
+    assert_close_vec(
+        ca.pos,
+        DVec2::new(5.0 - 0.6, 5.0),
+        ROUND_OFF,
+        "caller position",
+    );
+    assert_close_vec(
+        cb.pos,
+        DVec2::new(5.0 + 0.2, 5.0),
+        ROUND_OFF,
+        "arg position",
+    );
 
     let c3 = DVec3::splat(5.0);
     let mut world = world3(10.0);
@@ -600,7 +615,7 @@ fn coincident_centres_separate_along_plus_x_without_nan() {
     assert_close(
         cb.pos.x - ca.pos.x,
         1.0,
-        1e-12,
+        ROUND_OFF,
         "3D: separated along +x to touching",
     );
     assert_eq!(
@@ -633,11 +648,16 @@ fn separation_leaves_pair_touching_with_centre_of_mass_in_place() {
         assert_close(
             (cb.pos - ca.pos).length(),
             r1 + r2,
-            1e-12,
+            ROUND_OFF,
             "distance after separation",
         );
         let com = |x1: DVec2, x2: DVec2| (x1 * m1 + x2 * m2) / (m1 + m2);
-        assert_close_vec(com(ca.pos, cb.pos), com(p1, p2), 1e-12, "centre of mass");
+        assert_close_vec(
+            com(ca.pos, cb.pos),
+            com(p1, p2),
+            ROUND_OFF,
+            "centre of mass",
+        );
         assert_eq!(
             (ca.vel, cb.vel),
             (DVec2::ZERO, DVec2::ZERO),

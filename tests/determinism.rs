@@ -143,7 +143,7 @@ fn ball_crossing_the_periodic_edge_reappears_opposite_with_the_same_velocity() {
         assert_close_vec(
             c.pos,
             after_move(p, v, world.dt()) + shift,
-            1e-12,
+            ROUND_OFF,
             &format!("from {p}: position"),
         );
         assert!((0.0..10.0).contains(&c.pos.x) && (0.0..10.0).contains(&c.pos.y));
@@ -176,32 +176,32 @@ fn balls_touching_across_the_periodic_edge_collide_elastically() {
     );
     let (ca, cb) = (world.get(a).unwrap(), world.get(b).unwrap());
     let (want_a, want_b) = pop_elastic(va.dot(n), vb.dot(n), mb / ma);
-    assert_close(ca.vel.dot(n), want_a, 1e-12, "caller normal velocity");
-    assert_close(cb.vel.dot(n), want_b, 1e-12, "arg normal velocity");
+    assert_close(ca.vel.dot(n), want_a, ROUND_OFF, "caller normal velocity");
+    assert_close(cb.vel.dot(n), want_b, ROUND_OFF, "arg normal velocity");
     assert_close_vec(
         tangential(ca.vel, n),
         tangential(va, n),
-        1e-12,
+        ROUND_OFF,
         "caller tangential",
     );
     assert_close_vec(
         tangential(cb.vel, n),
         tangential(vb, n),
-        1e-12,
+        ROUND_OFF,
         "arg tangential",
     );
     assert_close_vec(
         world.momentum(),
         p0,
-        1e-14 * (ma * va.length() + mb * vb.length()),
+        MOMENTUM_ROUND_OFF * (ma * va.length() + mb * vb.length()),
         "momentum",
     );
-    assert_close(world.kinetic_energy(), e0, 1e-12 * e0, "kinetic energy");
+    assert_close(world.kinetic_energy(), e0, ROUND_OFF * e0, "kinetic energy");
     // Separated to touching through the edge, without leaving the box.
     let mut gap = cb.pos - ca.pos;
     gap.x -= 10.0 * (gap.x / 10.0).round();
     gap.y -= 10.0 * (gap.y / 10.0).round();
-    assert_close(gap.length(), 1.0, 1e-12, "distance through the edge");
+    assert_close(gap.length(), 1.0, ROUND_OFF, "distance through the edge");
     for c in [ca, cb] {
         assert!((0.0..10.0).contains(&c.pos.x) && (0.0..10.0).contains(&c.pos.y));
     }
@@ -211,7 +211,6 @@ fn balls_touching_across_the_periodic_edge_collide_elastically() {
 /// wraps every critter back in. The separation after a collision is applied after the move, so a
 /// push across the edge should be wrapped too.
 #[test]
-
 fn separation_across_the_periodic_edge_keeps_positions_in_the_box() {
     let mut world = wrap_world();
     let a = world

@@ -7,40 +7,10 @@ mod common;
 use common::*;
 use critterbox::glam::DVec2;
 use critterbox::{
-    CollideCtx, CritterId, CritterSpec, Error, KindDefaults, KindHooks, UpdateCtx, World,
-    CP_BULLET, CP_PLAYER,
+    CollideCtx, CritterId, CritterSpec, Error, KindDefaults, KindHooks, UpdateCtx, World, CP_PLAYER,
 };
 use std::cell::Cell;
 use std::rc::Rc;
-
-fn world_with_kinds() -> World<DVec2> {
-    let mut world = world2(10.0);
-    let bullet = KindDefaults {
-        priority: CP_BULLET,
-        radius: 0.1,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("bullet", None, bullet, Rc::new(Bullet))
-        .unwrap();
-    let target = KindDefaults {
-        health: 3.0,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("target", None, target, Rc::new(()))
-        .unwrap();
-    let basket = KindDefaults {
-        priority: CP_PLAYER,
-        radius: 2.0,
-        fixed: true,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("basket", None, basket, Rc::new(Basket))
-        .unwrap();
-    world
-}
 
 fn count(world: &World<DVec2>, kind: &str) -> usize {
     world.count_by_kind().get(kind).copied().unwrap_or(0)
@@ -48,7 +18,7 @@ fn count(world: &World<DVec2>, kind: &str) -> usize {
 
 #[test]
 fn bullet_touching_two_targets_at_once_damages_only_one() {
-    let mut world = world_with_kinds();
+    let mut world = classic_world();
     let b = world
         .spawn(CritterSpec::new("bullet", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -88,7 +58,7 @@ fn critter_killed_in_a_step_takes_no_further_collisions_in_it() {
         DVec2::new(-1.0, 0.0),
     );
     // Control: without the basket the two balls collide in this step.
-    let mut control = world_with_kinds();
+    let mut control = classic_world();
     control.spawn(CritterSpec::ball(p1).radius(0.5)).unwrap();
     let c2 = control
         .spawn(CritterSpec::ball(p2).vel(v2).radius(0.5))
@@ -100,7 +70,7 @@ fn critter_killed_in_a_step_takes_no_further_collisions_in_it() {
         "test setup: the balls collide"
     );
 
-    let mut world = world_with_kinds();
+    let mut world = classic_world();
     world
         .spawn(CritterSpec::new("basket", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -152,9 +122,12 @@ impl KindHooks<DVec2> for Mayfly {
 #[test]
 fn critter_that_dies_in_update_takes_no_collision_that_step() {
     let mut world = world2(10.0);
-    world
-        .register_kind("mayfly", None, KindDefaults::default(), Rc::new(Mayfly))
-        .unwrap();
+    register(
+        &mut world,
+        "mayfly",
+        KindDefaults::default(),
+        Rc::new(Mayfly),
+    );
     let m = world
         .spawn(CritterSpec::new("mayfly", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -169,7 +142,7 @@ fn critter_that_dies_in_update_takes_no_collision_that_step() {
 
 #[test]
 fn ids_are_generational_so_a_dead_critters_id_never_names_its_successor() {
-    let mut world = world_with_kinds();
+    let mut world = classic_world();
     let b = world
         .spawn(CritterSpec::new("bullet", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -222,13 +195,12 @@ fn spawns_queued_from_a_hook_appear_after_the_step() {
         seen: Cell::new(0),
     });
     let mut world = world2(10.0);
-    let defaults = KindDefaults {
-        priority: CP_PLAYER,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("spawner", None, defaults, spawner.clone())
-        .unwrap();
+    register(
+        &mut world,
+        "spawner",
+        with_priority(CP_PLAYER),
+        spawner.clone(),
+    );
     world
         .spawn(CritterSpec::new("spawner", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -275,13 +247,12 @@ fn spawn_queued_in_the_step_a_critter_dies_reuses_its_slot_under_a_new_id() {
         }
     }
     let mut world = world2(10.0);
-    let killer = KindDefaults {
-        priority: CP_PLAYER,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("killer", None, killer, Rc::new(Killer))
-        .unwrap();
+    register(
+        &mut world,
+        "killer",
+        with_priority(CP_PLAYER),
+        Rc::new(Killer),
+    );
     world
         .spawn(CritterSpec::new("killer", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -312,13 +283,8 @@ impl KindHooks<DVec2> for Hitter {
 
 fn hitter_world(amount: f64) -> World<DVec2> {
     let mut world = world2(10.0);
-    let hitter = KindDefaults {
-        priority: CP_PLAYER,
-        ..KindDefaults::default()
-    };
-    world
-        .register_kind("hitter", None, hitter, Rc::new(Hitter { amount }))
-        .unwrap();
+    let hitter = Rc::new(Hitter { amount });
+    register(&mut world, "hitter", with_priority(CP_PLAYER), hitter);
     world
 }
 
@@ -381,23 +347,26 @@ impl KindHooks<DVec2> for Stillborn {
     }
 }
 
-/// The death is filed at once and carried out at the end of the next step, like any other; the
-/// step that removes the critter should report the death, or a recording never shows it.
-#[test]
-
-fn critter_killed_in_its_init_hook_is_removed_and_reported_by_the_next_step() {
+/// A world with one stillborn critter at (5, 5), dead but not yet removed.
+fn stillborn_world() -> (World<DVec2>, CritterId) {
     let mut world = world2(10.0);
-    world
-        .register_kind(
-            "stillborn",
-            None,
-            KindDefaults::default(),
-            Rc::new(Stillborn),
-        )
-        .unwrap();
+    register(
+        &mut world,
+        "stillborn",
+        KindDefaults::default(),
+        Rc::new(Stillborn),
+    );
     let s = world
         .spawn(CritterSpec::new("stillborn", DVec2::splat(5.0)))
         .unwrap();
+    (world, s)
+}
+
+/// The death is filed at once and carried out at the end of the next step, like any other; the
+/// step that removes the critter should report the death, or a recording never shows it.
+#[test]
+fn critter_killed_in_its_init_hook_is_removed_and_reported_by_the_next_step() {
+    let (mut world, s) = stillborn_world();
     assert!(
         !world.get(s).unwrap().is_alive(),
         "dead but not yet removed"
@@ -413,18 +382,7 @@ fn critter_killed_in_its_init_hook_is_removed_and_reported_by_the_next_step() {
 
 #[test]
 fn critter_killed_in_its_init_hook_takes_no_part_and_is_removed_after_the_next_step() {
-    let mut world = world2(10.0);
-    world
-        .register_kind(
-            "stillborn",
-            None,
-            KindDefaults::default(),
-            Rc::new(Stillborn),
-        )
-        .unwrap();
-    let s = world
-        .spawn(CritterSpec::new("stillborn", DVec2::splat(5.0)))
-        .unwrap();
+    let (mut world, s) = stillborn_world();
     let (p, v) = (DVec2::new(5.9, 5.0), DVec2::new(-1.0, 0.0));
     let b = world.spawn(CritterSpec::ball(p).vel(v)).unwrap();
     assert_eq!(count(&world, "stillborn"), 0, "the dead are not counted");

@@ -5,7 +5,7 @@
 
 use critterbox::scenes::{self, AnyWorld, Scene, SceneParams};
 use critterbox::script::{load_scene, ScriptOptions};
-use critterbox::{Locality, Method};
+use critterbox::{Locality, Method, Vector, World};
 use std::path::Path;
 
 /// Lays out every `every` steps from two critters on.
@@ -25,15 +25,15 @@ const NEVER: Locality = Locality {
 
 /// Everything a step shows: the hash, the events and log, the critters in id order.
 fn seen(w: &AnyWorld) -> (u64, String, String) {
+    fn shown<V: Vector>(w: &World<V>) -> (String, String) {
+        (
+            format!("{:?}", w.events()),
+            format!("{:?}", w.critters().iter().collect::<Vec<_>>()),
+        )
+    }
     let (events, critters) = match w {
-        AnyWorld::D2(w) => (
-            format!("{:?}", w.events()),
-            format!("{:?}", w.critters().iter().collect::<Vec<_>>()),
-        ),
-        AnyWorld::D3(w) => (
-            format!("{:?}", w.events()),
-            format!("{:?}", w.critters().iter().collect::<Vec<_>>()),
-        ),
+        AnyWorld::D2(w) => shown(w),
+        AnyWorld::D3(w) => shown(w),
     };
     (w.state_hash(), events, critters)
 }

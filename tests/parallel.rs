@@ -3,7 +3,7 @@
 use critterbox::glam::{DVec2, DVec3};
 use critterbox::scenes::{gas, GasParams};
 use critterbox::world::PARALLEL_MIN;
-use critterbox::Border;
+use critterbox::{Border, Vector};
 
 fn run_in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()
@@ -13,45 +13,47 @@ fn run_in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
-fn hashes_2d(border: Border, steps: usize) -> Vec<u64> {
-    let params = GasParams {
-        n: PARALLEL_MIN + 5_000,
-        border,
-        packing: 0.35,
-        ..GasParams::default()
-    };
-    let mut world = gas::<DVec2>(&params).expect("gas builds");
-    (0..steps)
-        .map(|_| {
-            world.step().expect("steps");
-            world.state_hash()
-        })
-        .collect()
+/// The state hash after each of `steps` steps of a gas of `params`, run on `threads` threads.
+fn gas_hashes<V: Vector>(params: &GasParams, steps: usize, threads: usize) -> Vec<u64> {
+    run_in_pool(threads, || {
+        let mut world = gas::<V>(params).expect("gas builds");
+        (0..steps)
+            .map(|_| {
+                world.step().expect("steps");
+                world.state_hash()
+            })
+            .collect()
+    })
 }
 
-#[test]
-fn a_large_2d_gas_is_bit_identical_on_one_two_and_three_threads() {
-    for border in [Border::Bounce, Border::Wrap] {
-        let one = run_in_pool(1, || hashes_2d(border, 40));
-        let two = run_in_pool(2, || hashes_2d(border, 40));
-        let three = run_in_pool(3, || hashes_2d(border, 40));
-        assert_eq!(one, two, "{border:?}: 1 and 2 threads differ");
-        assert_eq!(one, three, "{border:?}: 1 and 3 threads differ");
+/// A gas of `params` has the same hash after every step on each of `threads` as on one thread.
+fn check_same_bits_on<V: Vector>(params: &GasParams, steps: usize, threads: &[usize], label: &str) {
+    let one = gas_hashes::<V>(params, steps, 1);
+    for &n in threads {
+        assert_eq!(
+            one,
+            gas_hashes::<V>(params, steps, n),
+            "{label}: 1 and {n} threads differ"
+        );
     }
 }
 
 #[test]
-fn a_large_3d_gas_is_bit_identical_on_one_and_two_threads() {
-    let run = || {
+fn a_large_gas_is_bit_identical_on_any_number_of_threads() {
+    for border in [Border::Bounce, Border::Wrap] {
         let params = GasParams {
-            n: PARALLEL_MIN + 1_000,
+            n: PARALLEL_MIN + 5_000,
+            border,
+            packing: 0.35,
             ..GasParams::default()
         };
-        let mut world = gas::<DVec3>(&params).expect("gas builds");
-        world.run(20).expect("steps");
-        world.state_hash()
+        check_same_bits_on::<DVec2>(&params, 40, &[2, 3], &format!("2D, {border:?}"));
+    }
+    let params = GasParams {
+        n: PARALLEL_MIN + 1_000,
+        ..GasParams::default()
     };
-    assert_eq!(run_in_pool(1, run), run_in_pool(2, run));
+    check_same_bits_on::<DVec3>(&params, 20, &[2], "3D");
 }
 
 #[test]

@@ -7,224 +7,249 @@ mod common;
 use common::*;
 use critterbox::glam::DVec2;
 use critterbox::{
-    BroadPhaseMode, CollideRule, CritterId, CritterSpec, KindDefaults, KindHooks, Rng, WallBox,
-    World, WorldConfig, CP_BULLET, CP_CRITTER, CP_PLAYER,
+    BroadPhaseMode, CollideRule, CritterId, CritterSpec, KindDefaults, Rng, WallBox, World,
+    WorldConfig, CP_BULLET, CP_CRITTER, CP_PLAYER,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::rc::Rc;
 
-fn kind(priority: f64) -> KindDefaults {
-    KindDefaults {
+/// One side of a pair: its kind and how that kind was registered.
+#[derive(Clone, Copy)]
+struct Side {
+    kind: &'static str,
+    priority: f64,
+    /// What the kind answers to `collides_with` against a non-wall; Pop's default when `None`.
+    rule: Option<CollideRule>,
+    fixed: bool,
+}
+
+/// A free critter of kind `kind`, Pop's default rule.
+const fn free(kind: &'static str, priority: f64) -> Side {
+    Side {
+        kind,
         priority,
-        ..KindDefaults::default()
+        rule: None,
+        fixed: false,
     }
 }
 
-fn register(
-    world: &mut World<DVec2>,
-    name: &str,
-    defaults: KindDefaults,
-    hooks: Rc<dyn KindHooks<DVec2>>,
-) {
-    world
-        .register_kind(name, None, defaults, hooks)
-        .expect("kind registers");
+/// A free critter of kind `kind` whose kind answers `rule`.
+const fn saying(kind: &'static str, priority: f64, rule: CollideRule) -> Side {
+    Side {
+        rule: Some(rule),
+        ..free(kind, priority)
+    }
 }
 
-/// Two critters overlapping (0.9 apart, radius 0.5) and approaching.
-fn spawn_pair(world: &mut World<DVec2>, first: &str, second: &str) -> (CritterId, CritterId) {
-    let a = world
-        .spawn(CritterSpec::new(first, DVec2::new(4.0, 5.0)).vel(DVec2::new(0.5, 0.0)))
-        .unwrap();
-    let b = world
-        .spawn(CritterSpec::new(second, DVec2::new(4.9, 5.0)).vel(DVec2::new(-0.5, 0.0)))
-        .unwrap();
-    (a, b)
+/// A fixed critter of kind `kind`, Pop's default rule.
+const fn fixed(kind: &'static str, priority: f64) -> Side {
+    Side {
+        fixed: true,
+        ..free(kind, priority)
+    }
 }
+
+#[derive(Clone, Copy, Debug)]
+enum Who {
+    Left,
+    Right,
+}
+
+/// What must happen in the step.
+#[derive(Clone, Copy)]
+enum Meet {
+    /// `collide` is called once, by the first on the second.
+    Calls(Who, Who),
+    /// No `collide` call and no collision: both keep their velocities and pass through.
+    PassThrough,
+    /// The pair is not even ruled and neither is moved; freed, it collides.
+    NeverRuled,
+}
+
+/// A pair meeting head on: `left` at (4, 5) and `right` at (4.9, 5), overlapping and, when free,
+/// approaching at 0.5 each (a fixed critter is spawned at rest). `left` is spawned first, so it
+/// has the lower id, unless `left_reuses_a_lower_slot`: then `right` is spawned first and `left`
+/// later, into a slot freed below it.
+struct RoleCase {
+    why: &'static str,
+    left: Side,
+    right: Side,
+    left_reuses_a_lower_slot: bool,
+    meet: Meet,
+}
+
+const fn case(why: &'static str, left: Side, right: Side, meet: Meet) -> RoleCase {
+    RoleCase {
+        why,
+        left,
+        right,
+        left_reuses_a_lower_slot: false,
+        meet,
+    }
+}
+
+/// Pop's roles: the higher priority calls; at equal priority the lower id calls, unless a
+/// `collides_with` override from either side decides; two fixed critters never collide.
+const ROLE_CASES: [RoleCase; 11] = [
+    case(
+        "the higher priority calls, spawned first",
+        free("high", CP_PLAYER),
+        free("low", CP_CRITTER),
+        Meet::Calls(Who::Left, Who::Right),
+    ),
+    case(
+        "the higher priority calls, spawned second",
+        free("low", CP_CRITTER),
+        free("high", CP_PLAYER),
+        Meet::Calls(Who::Right, Who::Left),
+    ),
+    RoleCase {
+        left_reuses_a_lower_slot: true,
+        ..case(
+            "at equal priority the lower id calls, even when it was spawned later",
+            free("rec", CP_CRITTER),
+            free("rec", CP_CRITTER),
+            Meet::Calls(Who::Left, Who::Right),
+        )
+    },
+    case(
+        "two fixed critters never collide",
+        fixed("rec", CP_CRITTER),
+        fixed("rec", CP_CRITTER),
+        Meet::NeverRuled,
+    ),
+    case(
+        "a fixed and a free critter collide: at equal priority the lower id calls",
+        fixed("rec", CP_CRITTER),
+        free("rec", CP_CRITTER),
+        Meet::Calls(Who::Left, Who::Right),
+    ),
+    case(
+        "DontCollide from the higher priority, spawned first: no collision",
+        saying("ghost", CP_PLAYER, CollideRule::DontCollide),
+        free("rec", CP_CRITTER),
+        Meet::PassThrough,
+    ),
+    case(
+        "DontCollide from the higher priority, spawned second: no collision",
+        free("rec", CP_CRITTER),
+        saying("ghost", CP_PLAYER, CollideRule::DontCollide),
+        Meet::PassThrough,
+    ),
+    case(
+        "AsCaller from the higher id, at equal priority",
+        free("rec", CP_CRITTER),
+        saying("pushy", CP_CRITTER, CollideRule::AsCaller),
+        Meet::Calls(Who::Right, Who::Left),
+    ),
+    case(
+        "AsArg from the lower id, at equal priority",
+        saying("meek", CP_CRITTER, CollideRule::AsArg),
+        free("rec", CP_CRITTER),
+        Meet::Calls(Who::Right, Who::Left),
+    ),
+    case(
+        "against priority: the lower asks to call and the higher agrees to be the argument",
+        saying("humble", CP_BULLET, CollideRule::AsArg),
+        saying("bold", CP_CRITTER, CollideRule::AsCaller),
+        Meet::Calls(Who::Right, Who::Left),
+    ),
+    case(
+        "against priority, spawned the other way round",
+        saying("bold", CP_CRITTER, CollideRule::AsCaller),
+        saying("humble", CP_BULLET, CollideRule::AsArg),
+        Meet::Calls(Who::Left, Who::Right),
+    ),
+];
 
 #[test]
-fn higher_priority_critter_is_the_caller_whatever_the_spawn_order() {
-    for high_first in [true, false] {
+fn who_calls_collide_on_whom_follows_pop_s_roles() {
+    const LEFT: (DVec2, DVec2) = (DVec2::new(4.0, 5.0), DVec2::new(0.5, 0.0));
+    const RIGHT: (DVec2, DVec2) = (DVec2::new(4.9, 5.0), DVec2::new(-0.5, 0.0));
+    for case in &ROLE_CASES {
+        let why = case.why;
         let log = call_log();
         let mut world = world2(10.0);
-        register(
-            &mut world,
-            "low",
-            kind(CP_CRITTER),
-            Rc::new(Recorder::new(&log)),
-        );
-        register(
-            &mut world,
-            "high",
-            kind(CP_PLAYER),
-            Rc::new(Recorder::new(&log)),
-        );
-        let (a, b) = if high_first {
-            spawn_pair(&mut world, "high", "low")
-        } else {
-            spawn_pair(&mut world, "low", "high")
+        for side in [case.left, case.right] {
+            if world.kinds().id(side.kind).is_ok() {
+                continue; // both sides of one kind
+            }
+            let recorder = match side.rule {
+                Some(rule) => Recorder::saying(&log, rule),
+                None => Recorder::new(&log),
+            };
+            register(
+                &mut world,
+                side.kind,
+                with_priority(side.priority),
+                Rc::new(recorder),
+            );
+        }
+        let spec = |side: Side, (pos, vel): (DVec2, DVec2)| {
+            let vel = if side.fixed { DVec2::ZERO } else { vel };
+            CritterSpec::new(side.kind, pos).vel(vel).fixed(side.fixed)
         };
-        let (high, low) = if high_first { (a, b) } else { (b, a) };
-        world.step().unwrap();
-        assert_eq!(*log.borrow(), vec![(high, low)], "high first: {high_first}");
-    }
-}
-
-#[test]
-fn equal_priority_lets_the_lower_id_call_even_when_it_was_spawned_later() {
-    let log = call_log();
-    let mut world = world2(10.0);
-    register(
-        &mut world,
-        "rec",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::new(&log)),
-    );
-    let old = world
-        .spawn(CritterSpec::new("rec", DVec2::new(1.0, 1.0)))
-        .unwrap();
-    let b = world
-        .spawn(CritterSpec::new("rec", DVec2::new(4.9, 5.0)).vel(DVec2::new(-0.5, 0.0)))
-        .unwrap();
-    world.remove(old).unwrap();
-    // The freed slot 0 is reused: the newer critter has the lower id.
-    let a = world
-        .spawn(CritterSpec::new("rec", DVec2::new(4.0, 5.0)).vel(DVec2::new(0.5, 0.0)))
-        .unwrap();
-    assert!(
-        a < b && a.index < b.index,
-        "test setup: the later spawn reuses the lower slot"
-    );
-    world.step().unwrap();
-    assert_eq!(*log.borrow(), vec![(a, b)]);
-}
-
-#[test]
-fn two_fixed_critters_never_collide() {
-    let log = call_log();
-    let mut world = world2(10.0);
-    register(
-        &mut world,
-        "rec",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::new(&log)),
-    );
-    let a = world
-        .spawn(CritterSpec::new("rec", DVec2::new(4.0, 5.0)).fixed(true))
-        .unwrap();
-    let b = world
-        .spawn(CritterSpec::new("rec", DVec2::new(4.6, 5.0)).fixed(true))
-        .unwrap();
-    world.step().unwrap();
-    assert!(
-        log.borrow().is_empty(),
-        "collide was called on two fixed critters"
-    );
-    assert_eq!(world.stats().ruled, 0);
-    assert_eq!(
-        world.get(a).unwrap().pos,
-        DVec2::new(4.0, 5.0),
-        "fixed critters were separated"
-    );
-    assert_eq!(world.get(b).unwrap().pos, DVec2::new(4.6, 5.0));
-    // Control: free one of them and the pair collides.
-    world.get_mut(b).unwrap().set_fixed(false);
-    world.step().unwrap();
-    assert_eq!(log.borrow().len(), 1);
-}
-
-/// DontCollide from either side: no call, the pair passes through, velocities unchanged.
-#[test]
-fn dont_collide_from_one_side_means_no_collision() {
-    for ghost_first in [true, false] {
-        let log = call_log();
-        let mut world = world2(10.0);
-        register(
-            &mut world,
-            "rec",
-            kind(CP_CRITTER),
-            Rc::new(Recorder::new(&log)),
-        );
-        let ghost = Recorder::saying(&log, CollideRule::DontCollide);
-        register(&mut world, "ghost", kind(CP_PLAYER), Rc::new(ghost));
-        let (a, b) = if ghost_first {
-            spawn_pair(&mut world, "ghost", "rec")
+        let (left, right) = if case.left_reuses_a_lower_slot {
+            let placeholder = world
+                .spawn(CritterSpec::new(case.left.kind, DVec2::new(1.0, 1.0)))
+                .unwrap();
+            let right = world.spawn(spec(case.right, RIGHT)).unwrap();
+            world.remove(placeholder).unwrap();
+            let left = world.spawn(spec(case.left, LEFT)).unwrap();
+            assert!(
+                left < right && left.index < right.index,
+                "{why}: test setup: the later spawn reuses the lower slot"
+            );
+            (left, right)
         } else {
-            spawn_pair(&mut world, "rec", "ghost")
+            let left = world.spawn(spec(case.left, LEFT)).unwrap();
+            (left, world.spawn(spec(case.right, RIGHT)).unwrap())
         };
         world.step().unwrap();
-        assert!(log.borrow().is_empty());
-        assert!(world.events().collisions.is_empty());
-        assert_eq!(world.get(a).unwrap().vel, DVec2::new(0.5, 0.0));
-        assert_eq!(world.get(b).unwrap().vel, DVec2::new(-0.5, 0.0));
+        let id = |who: Who| match who {
+            Who::Left => left,
+            Who::Right => right,
+        };
+        match case.meet {
+            Meet::Calls(caller, arg) => {
+                assert_eq!(
+                    *log.borrow(),
+                    vec![(id(caller), id(arg))],
+                    "{why}: {caller:?} should call {arg:?}"
+                );
+            }
+            Meet::PassThrough => {
+                assert!(log.borrow().is_empty(), "{why}: collide was called");
+                assert!(
+                    world.events().collisions.is_empty(),
+                    "{why}: a collision was reported"
+                );
+                assert_eq!(
+                    world.get(left).unwrap().vel,
+                    LEFT.1,
+                    "{why}: left's velocity"
+                );
+                assert_eq!(
+                    world.get(right).unwrap().vel,
+                    RIGHT.1,
+                    "{why}: right's velocity"
+                );
+            }
+            Meet::NeverRuled => {
+                assert!(log.borrow().is_empty(), "{why}: collide was called");
+                assert_eq!(world.stats().ruled, 0, "{why}: the pair was ruled");
+                assert_eq!(
+                    [world.get(left).unwrap().pos, world.get(right).unwrap().pos],
+                    [LEFT.0, RIGHT.0],
+                    "{why}: the pair was moved or separated"
+                );
+                // Control: free one of them and the pair collides.
+                world.get_mut(right).unwrap().set_fixed(false);
+                world.step().unwrap();
+                assert_eq!(log.borrow().len(), 1, "{why}: freed, the pair collides");
+            }
+        }
     }
-}
-
-#[test]
-fn as_caller_and_as_arg_overrides_flip_the_roles() {
-    // Equal priority, so the lower id would call: an override from either side decides instead.
-    let log = call_log();
-    let mut world = world2(10.0);
-    register(
-        &mut world,
-        "rec",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::new(&log)),
-    );
-    register(
-        &mut world,
-        "pushy",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::saying(&log, CollideRule::AsCaller)),
-    );
-    let (rec, pushy) = spawn_pair(&mut world, "rec", "pushy");
-    world.step().unwrap();
-    assert_eq!(
-        *log.borrow(),
-        vec![(pushy, rec)],
-        "AsCaller from the higher id"
-    );
-
-    let log = call_log();
-    let mut world = world2(10.0);
-    register(
-        &mut world,
-        "rec",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::new(&log)),
-    );
-    register(
-        &mut world,
-        "meek",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::saying(&log, CollideRule::AsArg)),
-    );
-    let (meek, rec) = spawn_pair(&mut world, "meek", "rec");
-    world.step().unwrap();
-    assert_eq!(*log.borrow(), vec![(rec, meek)], "AsArg from the lower id");
-
-    // Against priority: the low one asks to call and the high one agrees to be the argument.
-    let log = call_log();
-    let mut world = world2(10.0);
-    register(
-        &mut world,
-        "bold",
-        kind(CP_CRITTER),
-        Rc::new(Recorder::saying(&log, CollideRule::AsCaller)),
-    );
-    register(
-        &mut world,
-        "humble",
-        kind(CP_BULLET),
-        Rc::new(Recorder::saying(&log, CollideRule::AsArg)),
-    );
-    let (humble, bold) = spawn_pair(&mut world, "humble", "bold");
-    world.step().unwrap();
-    assert_eq!(
-        *log.borrow(),
-        vec![(bold, humble)],
-        "the lower priority calls when both agree"
-    );
 }
 
 /// Zero velocities, so the touching pairs of the step are those of the starting positions.
@@ -235,7 +260,7 @@ fn each_touching_pair_is_handled_exactly_once_per_step() {
     register(
         &mut world,
         "rec",
-        kind(CP_CRITTER),
+        with_priority(CP_CRITTER),
         Rc::new(Recorder::new(&log)),
     );
     let mut rng = Rng::new(11);
@@ -257,10 +282,10 @@ fn each_touching_pair_is_handled_exactly_once_per_step() {
         for (i, a) in critters.iter().enumerate() {
             for b in &critters[i + 1..] {
                 let gap = (b.1 - a.1).length() - (a.2 + b.2);
-                if gap < -1e-9 {
+                if gap < -POSITION_DRIFT {
                     touching.insert((a.0, b.0));
                 }
-                if gap <= 1e-9 {
+                if gap <= POSITION_DRIFT {
                     near.insert((a.0, b.0));
                 }
             }
@@ -302,8 +327,8 @@ fn collide_roles_are_cached_per_kind_pair_however_many_critters() {
     world
         .add_wall(WallBox::segment(DVec2::new(5.0, 20.0), DVec2::new(35.0, 20.0), 0.3).unwrap())
         .unwrap();
-    register(&mut world, "red", kind(CP_CRITTER), red.clone());
-    register(&mut world, "blue", kind(CP_PLAYER), blue.clone());
+    register(&mut world, "red", with_priority(CP_CRITTER), red.clone());
+    register(&mut world, "blue", with_priority(CP_PLAYER), blue.clone());
     let mut rng = Rng::new(3);
     for i in 0..1000 {
         let name = ["ball", "red", "blue"][i % 3];
@@ -350,7 +375,12 @@ fn kind_whose_rule_depends_on_state_is_asked_for_every_pair_every_step() {
         ..Recorder::new(&log)
     });
     let mut world = world2(10.0);
-    register(&mut world, "moody", kind(CP_CRITTER), moody.clone());
+    register(
+        &mut world,
+        "moody",
+        with_priority(CP_CRITTER),
+        moody.clone(),
+    );
     for i in 0..6 {
         world
             .spawn(CritterSpec::new(
@@ -393,7 +423,12 @@ fn a_large_crowd_whose_rule_depends_on_state_meets_as_with_the_plain_grid() {
         let mut config = WorldConfig::new(DVec2::ZERO, DVec2::splat(300.0));
         config.broad_phase = mode;
         let mut world = World::new(config).unwrap();
-        register(&mut world, "moody", kind(CP_CRITTER), moody.clone());
+        register(
+            &mut world,
+            "moody",
+            with_priority(CP_CRITTER),
+            moody.clone(),
+        );
         let mut rng = Rng::new(8);
         for i in 0..22_000 {
             let name = if i % 4 == 0 { "moody" } else { "ball" };
@@ -417,25 +452,9 @@ fn a_large_crowd_whose_rule_depends_on_state_meets_as_with_the_plain_grid() {
 
 // ----- the classic kinds ------------------------------------------------------------------------
 
-fn bullet_world() -> World<DVec2> {
-    let mut world = world2(10.0);
-    let bullet = KindDefaults {
-        priority: CP_BULLET,
-        radius: 0.1,
-        ..KindDefaults::default()
-    };
-    register(&mut world, "bullet", bullet, Rc::new(Bullet));
-    let target = KindDefaults {
-        health: 3.0,
-        ..KindDefaults::default()
-    };
-    register(&mut world, "target", target, Rc::new(()));
-    world
-}
-
 #[test]
 fn bullet_damages_a_target_and_dies_without_bouncing_it() {
-    let mut world = bullet_world();
+    let mut world = classic_world();
     let t = world
         .spawn(CritterSpec::new("target", DVec2::new(5.0, 5.0)).vel(DVec2::new(0.0, 0.3)))
         .unwrap();
@@ -463,7 +482,7 @@ fn bullet_damages_a_target_and_dies_without_bouncing_it() {
 
 #[test]
 fn bullet_collides_normally_with_a_non_target() {
-    let mut world = bullet_world();
+    let mut world = classic_world();
     let (mb, mo) = (0.001, 0.125); // radius 0.1 at density 1; radius 0.5 at density 1
     let o = world
         .spawn(CritterSpec::ball(DVec2::new(5.0, 5.0)))
@@ -482,13 +501,13 @@ fn bullet_collides_normally_with_a_non_target() {
     assert_close_vec(
         world.get(b).unwrap().vel,
         DVec2::new(vb, 0.0),
-        1e-12,
+        ROUND_OFF,
         "bullet bounced",
     );
     assert_close_vec(
         world.get(o).unwrap().vel,
         DVec2::new(vo, 0.0),
-        1e-12,
+        ROUND_OFF,
         "ball pushed",
     );
     assert_eq!(world.get(o).unwrap().health(), 1.0, "no damage");
@@ -496,14 +515,7 @@ fn bullet_collides_normally_with_a_non_target() {
 
 #[test]
 fn basket_kills_what_it_contains_and_ignores_what_it_only_touches() {
-    let mut world = world2(10.0);
-    let basket = KindDefaults {
-        priority: CP_PLAYER,
-        radius: 2.0,
-        fixed: true,
-        ..KindDefaults::default()
-    };
-    register(&mut world, "basket", basket, Rc::new(Basket));
+    let mut world = classic_world();
     world
         .spawn(CritterSpec::new("basket", DVec2::new(5.0, 5.0)))
         .unwrap();
@@ -566,7 +578,7 @@ fn sensitive_player_takes_damage_from_critters_but_not_from_walls() {
 
 #[test]
 fn kind_registered_with_a_parent_is_kind_of_the_parent() {
-    let mut world = bullet_world();
+    let mut world = classic_world();
     let silver = KindDefaults {
         priority: CP_BULLET,
         radius: 0.1,

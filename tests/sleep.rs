@@ -2,32 +2,45 @@
 //! exactly where it was, and every documented way of waking it wakes it, with the physics of
 //! what follows checked against free fall and against overlap.
 
+mod common;
+
+use common::*;
 use critterbox::glam::DVec2;
 use critterbox::method::sleep::{SLEEP_SPEED_STEPS, SLEEP_STEPS};
 use critterbox::scenes::{gas, GasParams};
 use critterbox::wall::WallBox;
 use critterbox::{CritterId, CritterSpec, Method, World, WorldConfig};
 
-const DT: f64 = 1.0 / 60.0;
-const G: f64 = 9.81;
 const R: f64 = 0.5;
 
-/// A walled box 12 wide with `n` balls of radius 0.5 dropped in rows, under `solve:8`.
-fn pile(n: usize, sleep: bool) -> (World<DVec2>, Vec<CritterId>) {
-    let config = WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(13.0, 40.0))
+/// The box from `lo` to `hi` under gravity, stepped by `solve:8`.
+fn falling(lo: DVec2, hi: DVec2) -> WorldConfig<DVec2> {
+    WorldConfig::new(lo, hi)
         .gravity(DVec2::new(0.0, -G))
         .dt(DT)
         .method(Method::Solve(8))
-        .sleep(sleep)
-        .seed(7);
+}
+
+/// A world of `config` with an aligned wall from `lo` to `hi` for each of `walls`.
+fn walled(config: WorldConfig<DVec2>, walls: &[(DVec2, DVec2)]) -> World<DVec2> {
     let mut w = World::new(config).unwrap();
-    for (lo, hi) in [
-        (DVec2::new(-1.0, -1.0), DVec2::new(0.0, 40.0)),
-        (DVec2::new(12.0, -1.0), DVec2::new(13.0, 40.0)),
-        (DVec2::new(-1.0, -1.0), DVec2::new(13.0, 0.0)),
-    ] {
+    for &(lo, hi) in walls {
         w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
     }
+    w
+}
+
+/// A walled box 12 wide with `n` balls of radius 0.5 dropped in rows, under `solve:8`.
+fn pile(n: usize, sleep: bool) -> (World<DVec2>, Vec<CritterId>) {
+    let (lo, hi) = (DVec2::new(-1.0, -1.0), DVec2::new(13.0, 40.0));
+    let mut w = walled(
+        falling(lo, hi).sleep(sleep).seed(7),
+        &[
+            (lo, DVec2::new(0.0, 40.0)),
+            (DVec2::new(12.0, -1.0), hi),
+            (lo, DVec2::new(13.0, 0.0)),
+        ],
+    );
     let ids = (0..n)
         .map(|i| {
             let (row, col) = (i / 10, i % 10);
@@ -60,18 +73,6 @@ fn until_asleep(w: &mut World<DVec2>, ids: &[CritterId], limit: u64) -> u64 {
     );
 }
 
-/// The deepest overlap of two balls, in radii.
-fn deepest_overlap(w: &World<DVec2>) -> f64 {
-    let balls: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
-    let mut deepest: f64 = 0.0;
-    for (i, a) in balls.iter().enumerate() {
-        for b in &balls[i + 1..] {
-            deepest = deepest.max((a.radius() + b.radius() - a.pos.distance(b.pos)) / R);
-        }
-    }
-    deepest
-}
-
 #[test]
 fn a_resting_pile_falls_asleep_and_then_stays_exactly_where_it_was() {
     let (mut w, ids) = pile(60, true);
@@ -94,7 +95,7 @@ fn a_resting_pile_falls_asleep_and_then_stays_exactly_where_it_was() {
     }
     let stats = w.stats();
     assert_eq!(stats.contacts, 0, "no pair of sleepers is tested");
-    assert!(deepest_overlap(&w) < 0.05, "{}", deepest_overlap(&w));
+    assert!(deepest_overlap(&w, R) < 0.05, "{}", deepest_overlap(&w, R));
 }
 
 #[test]
@@ -151,24 +152,21 @@ fn a_ball_dropped_on_a_sleeping_pile_wakes_it_and_all_of_it_rests_again() {
     let mut all = ids.clone();
     all.push(drop);
     until_asleep(&mut w, &all, 2000);
-    assert!(deepest_overlap(&w) < 0.05, "{}", deepest_overlap(&w));
+    assert!(deepest_overlap(&w, R) < 0.05, "{}", deepest_overlap(&w, R));
 }
 
 #[test]
 fn removing_a_support_wakes_what_rests_on_it_and_it_falls_freely() {
     // A column of three in a chute one ball wide, asleep: the bottom one is removed.
-    let config = WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(3.0, 20.0))
-        .gravity(DVec2::new(0.0, -G))
-        .dt(DT)
-        .method(Method::Solve(8));
-    let mut w = World::new(config).unwrap();
-    for (lo, hi) in [
-        (DVec2::new(-1.0, -1.0), DVec2::new(0.0, 20.0)),
-        (DVec2::new(1.02, -1.0), DVec2::new(3.0, 20.0)),
-        (DVec2::new(-1.0, -1.0), DVec2::new(3.0, 0.0)),
-    ] {
-        w.add_wall(WallBox::aligned(lo, hi).unwrap()).unwrap();
-    }
+    let (lo, hi) = (DVec2::new(-1.0, -1.0), DVec2::new(3.0, 20.0));
+    let mut w = walled(
+        falling(lo, hi),
+        &[
+            (lo, DVec2::new(0.0, 20.0)),
+            (DVec2::new(1.02, -1.0), hi),
+            (lo, DVec2::new(3.0, 0.0)),
+        ],
+    );
     let column: Vec<CritterId> = (0..3)
         .map(|k| {
             let pos = DVec2::new(0.51, 0.5 + k as f64 * 1.2);
@@ -191,7 +189,7 @@ fn removing_a_support_wakes_what_rests_on_it_and_it_falls_freely() {
     let want = y - G * t * (t + DT) / 2.0;
     let got = centre(&w);
     assert!(
-        (got - want).abs() < 1e-9,
+        (got - want).abs() < POSITION_DRIFT,
         "their centre fell to {got}, free fall gives {want}"
     );
     assert!(!w.is_asleep(column[2]), "the top ball woke too");
@@ -214,7 +212,11 @@ fn a_sleeper_pushed_by_the_host_wakes_and_moves() {
     let c = w.get(top).unwrap();
     // One step of semi-implicit Euler under gravity, nothing touched on the way up.
     let want = p0 + (kick + DVec2::new(0.0, -G * DT)) * DT;
-    assert!((c.pos - want).length() < 1e-12, "{} against {want}", c.pos);
+    assert!(
+        (c.pos - want).length() < ROUND_OFF,
+        "{} against {want}",
+        c.pos
+    );
 }
 
 #[test]
@@ -228,7 +230,7 @@ fn a_sleeper_teleported_by_the_host_wakes() {
     assert!(!w.is_asleep(id));
     let y = w.get(id).unwrap().pos.y;
     assert!(
-        (y - (to.y - G * DT * DT)).abs() < 1e-12,
+        (y - (to.y - G * DT * DT)).abs() < ROUND_OFF,
         "it fell from where it was put: {y}"
     );
 }
@@ -238,13 +240,11 @@ fn the_threshold_is_a_share_of_a_step_of_gravity() {
     // A ball rolling along the floor slower than the threshold sleeps; one faster does not.
     let threshold = SLEEP_SPEED_STEPS * G * DT;
     for (speed, sleeps) in [(0.5 * threshold, true), (2.0 * threshold, false)] {
-        let config = WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(1000.0, 5.0))
-            .gravity(DVec2::new(0.0, -G))
-            .dt(DT)
-            .method(Method::Solve(8));
-        let mut w = World::new(config).unwrap();
-        w.add_wall(WallBox::aligned(DVec2::new(-1.0, -1.0), DVec2::new(1000.0, 0.0)).unwrap())
-            .unwrap();
+        let lo = DVec2::new(-1.0, -1.0);
+        let mut w = walled(
+            falling(lo, DVec2::new(1000.0, 5.0)),
+            &[(lo, DVec2::new(1000.0, 0.0))],
+        );
         let id = w
             .spawn(
                 CritterSpec::ball(DVec2::new(1.0, R))
@@ -305,13 +305,12 @@ fn a_collide_hook_that_takes_a_sleeper_wakes_its_island() {
         priority: 1e6,
         ..KindDefaults::default()
     };
-    w.register_kind(
+    register(
+        &mut w,
         "counting",
-        None,
         defaults,
         std::rc::Rc::new(Counting(calls.clone())),
-    )
-    .unwrap();
+    );
     until_asleep(&mut w, &ids, 1500);
     // A fixed critter at rest, overlapping the top ball a little: it never moves, so only its
     // hook can wake the pile.

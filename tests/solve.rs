@@ -2,6 +2,9 @@
 //! of mass moving on undisturbed), momentum in a gas, a column brought to rest where the
 //! discrete step sinks, kinds' own hooks kept, the documented failures.
 
+mod common;
+
+use common::*;
 use critterbox::context::CollideCtx;
 use critterbox::glam::DVec2;
 use critterbox::kind::{KindDefaults, KindHooks};
@@ -12,8 +15,6 @@ use critterbox::stability::pile;
 use critterbox::wall::WallBox;
 use critterbox::{Border, CritterSpec, Error, Method, World, WorldConfig};
 use std::rc::Rc;
-
-const DT: f64 = 1.0 / 60.0;
 
 fn open_world(method: Method, gravity: DVec2) -> World<DVec2> {
     World::new(
@@ -57,11 +58,11 @@ fn an_isolated_pair_gets_pop_s_impulse_in_one_sweep_and_in_eight() {
             let (got_a, got_b) = (w.get(ia).unwrap().vel, w.get(ib).unwrap().vel);
             let what = format!("solve:{sweeps}, e {e}, m2 {m2}, dy {dy}");
             assert!(
-                (got_a - want_a).length() < 1e-12,
+                (got_a - want_a).length() < ROUND_OFF,
                 "{what}: {got_a} vs {want_a}"
             );
             assert!(
-                (got_b - want_b).length() < 1e-12,
+                (got_b - want_b).length() < ROUND_OFF,
                 "{what}: {got_b} vs {want_b}"
             );
             // The impulses and the position sweeps are internal: the centre of mass moves on
@@ -70,7 +71,7 @@ fn an_isolated_pair_gets_pop_s_impulse_in_one_sweep_and_in_eight() {
             let centre = (pa * a.2 + pb * b.2) / (a.2 + b.2);
             let free = (a.0 * a.2 + b.0 * b.2 + (a.1 * a.2 + b.1 * b.2) * DT) / (a.2 + b.2);
             assert!(
-                (centre - free).length() < 1e-12,
+                (centre - free).length() < ROUND_OFF,
                 "{what}: {centre} vs {free}"
             );
             assert_eq!(w.events().collisions.len(), 1, "{what}");
@@ -95,7 +96,7 @@ fn momentum_is_kept_in_a_periodic_gas() {
         w.step().unwrap();
         contacts += w.stats().contacts;
         let drift = (w.momentum() - p0).length() / scale;
-        assert!(drift < 1e-12, "momentum drift {drift}");
+        assert!(drift < ROUND_OFF, "momentum drift {drift}");
     }
     assert!(contacts > 1_000, "the gas collides ({contacts} contacts)");
 }
@@ -104,7 +105,7 @@ fn momentum_is_kept_in_a_periodic_gas() {
 /// speed of the fastest ball and the deepest overlap (in radii) after `steps` steps, with sleep
 /// off.
 fn column(method: Method, steps: u64) -> (f64, f64) {
-    let mut w = open_world(method, DVec2::new(0.0, -9.81));
+    let mut w = open_world(method, DVec2::new(0.0, -G));
     w.set_sleep(false); // the solve itself must bring the column to rest
     w.add_wall(WallBox::aligned(DVec2::new(0.0, 0.0), DVec2::new(20.0, 0.5)).unwrap())
         .unwrap();
@@ -118,16 +119,23 @@ fn column(method: Method, steps: u64) -> (f64, f64) {
         .unwrap();
     }
     w.run(steps).unwrap();
-    let balls: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
-    let fastest = balls.iter().map(|c| c.vel.length()).fold(0.0, f64::max);
-    let mut deepest: f64 = 0.0;
-    for (i, a) in balls.iter().enumerate() {
-        deepest = deepest.max((0.5 + r - a.pos.y) / r);
-        for b in &balls[i + 1..] {
-            deepest = deepest.max((2.0 * r - a.pos.distance(b.pos)) / r);
-        }
-    }
-    (fastest, deepest)
+    let fastest = w
+        .critters()
+        .iter()
+        .filter(|c| !c.is_wall())
+        .map(|c| c.vel.length())
+        .fold(0.0, f64::max);
+    (fastest, deepest_overlap_on(&w, r, 0.5))
+}
+
+/// The deepest overlap of balls of radius `r`, with each other or with the floor whose top is at
+/// `floor`, in radii.
+fn deepest_overlap_on(w: &World<DVec2>, r: f64, floor: f64) -> f64 {
+    w.critters()
+        .iter()
+        .filter(|c| !c.is_wall())
+        .map(|c| (floor + r - c.pos.y) / r)
+        .fold(deepest_overlap(w, r), f64::max)
 }
 
 /// The column comes to rest under `solve:8`: each step's gravity (g dt = 0.16) is taken out
@@ -135,7 +143,7 @@ fn column(method: Method, steps: u64) -> (f64, f64) {
 /// under the discrete step it keeps moving and sinks into itself (`docs/stability.md`).
 #[test]
 fn a_column_rests_under_solve_and_sinks_under_discrete() {
-    let g_dt = 9.81 * DT;
+    let g_dt = G * DT;
     let (fast, deep) = column(Method::Solve(8), 600);
     assert!(fast < 0.1 * g_dt, "solve:8 fastest ball {fast}");
     assert!(deep < 0.05, "solve:8 deepest overlap {deep} radii");
@@ -177,8 +185,8 @@ fn a_kind_s_own_collide_is_called_and_the_rest_are_solved() {
     assert_eq!(w.get(s1).unwrap().vel, DVec2::ZERO);
     assert_eq!(w.get(s2).unwrap().vel, DVec2::ZERO);
     // Equal balls head-on at e = 1 swap velocities.
-    assert!((w.get(b1).unwrap().vel - DVec2::new(-2.0, 0.0)).length() < 1e-12);
-    assert!((w.get(b2).unwrap().vel - DVec2::new(2.0, 0.0)).length() < 1e-12);
+    assert!((w.get(b1).unwrap().vel - DVec2::new(-2.0, 0.0)).length() < ROUND_OFF);
+    assert!((w.get(b2).unwrap().vel - DVec2::new(2.0, 0.0)).length() < ROUND_OFF);
 }
 
 /// The failures `docs/stability.md` documents for `solve:8`: it tunnels where discrete does (it
@@ -203,7 +211,7 @@ fn solve_tunnels_as_discrete_does_and_spreads_the_cradle_s_momentum() {
 fn sweeps_of_a_column(n: usize, on_floor: bool) -> u64 {
     let mut w = World::new(
         WorldConfig::new(DVec2::ZERO, DVec2::new(20.0, 100.0))
-            .gravity(DVec2::new(0.0, -9.81))
+            .gravity(DVec2::new(0.0, -G))
             .dt(DT)
             .method(Method::Auto),
     )
@@ -247,7 +255,7 @@ fn auto_gives_a_column_one_sweep_per_two_balls_of_its_height() {
 fn side_walls_and_level_contacts_carry_no_weight() {
     let mut w = World::new(
         WorldConfig::new(DVec2::new(-1.0, -1.0), DVec2::new(30.0, 10.0))
-            .gravity(DVec2::new(0.0, -9.81))
+            .gravity(DVec2::new(0.0, -G))
             .dt(DT)
             .method(Method::Auto),
     )
@@ -291,15 +299,7 @@ fn well_pile(method: Method, rows: usize, limit: u64) -> (Option<u64>, f64) {
             break;
         }
     }
-    let cs: Vec<_> = w.critters().iter().filter(|c| !c.is_wall()).collect();
-    let mut deepest: f64 = 0.0;
-    for (i, a) in cs.iter().enumerate() {
-        deepest = deepest.max((r - a.pos.y) / r);
-        for b in &cs[i + 1..] {
-            deepest = deepest.max((2.0 * r - a.pos.distance(b.pos)) / r);
-        }
-    }
-    (asleep, deepest)
+    (asleep, deepest_overlap_on(&w, r, 0.0))
 }
 
 /// Eight sweeps do not carry 40 rows: the pile keeps moving and never sleeps in 10 s. `auto`

@@ -1,19 +1,44 @@
 //! Helpers shared by the integration tests: worlds, the motion law of one step, Pop's 1-D elastic
-//! formulas, and tolerance checks that say what they compared.
+//! formulas, the tolerances the checks allow and checks that say what they compared, and the
+//! classic kinds written natively.
 //!
 //! Each test file uses only some of these, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
 use critterbox::glam::{DVec2, DVec3};
 use critterbox::{
-    default_collides_with, CollideCtx, CollideRule, CritterId, Error, KindHooks, RuleCtx, Vector,
-    World, WorldConfig,
+    default_collides_with, CollideCtx, CollideRule, CritterId, Error, KindDefaults, KindHooks,
+    RuleCtx, Vector, World, WorldConfig, CP_BULLET, CP_PLAYER,
 };
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 /// The default time step of a world.
 pub const DT: f64 = 1.0 / 60.0;
+
+/// Standard gravity, for the scenes that fall.
+pub const G: f64 = 9.81;
+
+// ----- tolerances -------------------------------------------------------------------------------
+// f64::EPSILON is 2.2e-16; each tolerance says how much rounding the compared result went through.
+
+/// The relative error an exact result may carry after the rounding of one step's arithmetic (a
+/// few thousand ulps); absolute for positions and velocities of order one.
+pub const ROUND_OFF: f64 = 1e-12;
+
+/// A few ulps of a quantity of order one: one rounded operation or a short sum.
+pub const FEW_ULPS: f64 = 1e-15;
+
+/// The relative change of total momentum a collision may show: its impulses are equal and
+/// opposite, so only the rounding of the sum of m v remains.
+pub const MOMENTUM_ROUND_OFF: f64 = 1e-14;
+
+/// The relative drift of a conserved quantity after hundreds of steps of rounded collisions.
+pub const LONG_RUN_ROUND_OFF: f64 = 1e-10;
+
+/// The absolute error positions may gather over several steps of separations and solve sweeps:
+/// a pair separated to touching is within it of touching, either side.
+pub const POSITION_DRIFT: f64 = 1e-9;
 
 /// An empty 2D world, bouncing border, from (0, 0) to (size, size).
 pub fn world2(size: f64) -> World<DVec2> {
@@ -28,6 +53,26 @@ pub fn world3(size: f64) -> World<DVec3> {
 /// An empty world of either dimension.
 pub fn world<V: Vector>(size: f64) -> World<V> {
     World::new(WorldConfig::new(V::zero(), V::splat(size))).expect("a valid world")
+}
+
+/// Registers kind `name` (no parent) with `defaults` and `hooks`.
+pub fn register<V: Vector>(
+    world: &mut World<V>,
+    name: &str,
+    defaults: KindDefaults,
+    hooks: Rc<dyn KindHooks<V>>,
+) {
+    world
+        .register_kind(name, None, defaults, hooks)
+        .unwrap_or_else(|e| panic!("kind {name} should register: {e}"));
+}
+
+/// The default kind with collide priority `priority`.
+pub fn with_priority(priority: f64) -> KindDefaults {
+    KindDefaults {
+        priority,
+        ..KindDefaults::default()
+    }
 }
 
 /// Where a free critter is after one step of straight-line motion (before any contact).
@@ -63,6 +108,24 @@ pub fn assert_close_vec<V: Vector>(actual: V, expected: V, tol: f64, what: &str)
     );
 }
 
+/// Asserts the velocity `after` is `before` reflected off a surface with unit normal `n`: its
+/// normal component reversed and its tangential one kept, to [`ROUND_OFF`].
+#[track_caller]
+pub fn assert_reflected<V: Vector>(after: V, before: V, n: V, label: &str) {
+    assert_close(
+        after.dot(n),
+        -before.dot(n),
+        ROUND_OFF,
+        &format!("{label}: normal velocity reversed"),
+    );
+    assert_close_vec(
+        tangential(after, n),
+        tangential(before, n),
+        ROUND_OFF,
+        &format!("{label}: tangential velocity kept"),
+    );
+}
+
 /// The unit vector along `v`.
 pub fn unit<V: Vector>(v: V) -> V {
     v * (1.0 / v.length())
@@ -95,6 +158,18 @@ pub fn state_bits<V: Vector>(world: &World<V>) -> StateBits {
             (c.id().index, c.id().generation, bits)
         })
         .collect()
+}
+
+/// The deepest overlap of two non-wall critters of `world`, in units of `r` (0 when none overlap).
+pub fn deepest_overlap<V: Vector>(world: &World<V>, r: f64) -> f64 {
+    let balls: Vec<_> = world.critters().iter().filter(|c| !c.is_wall()).collect();
+    let mut deepest: f64 = 0.0;
+    for (i, a) in balls.iter().enumerate() {
+        for b in &balls[i + 1..] {
+            deepest = deepest.max((a.radius() + b.radius() - (a.pos - b.pos).length()) / r);
+        }
+    }
+    deepest
 }
 
 /// Distance from point `p` to the axis-aligned box [lo, hi] (0 inside), computed independently
@@ -174,6 +249,32 @@ impl<V: Vector> KindHooks<V> for Recorder {
             .push((ctx.me().id(), ctx.other().id()));
         Ok(ctx.collide_default())
     }
+}
+
+/// A 10-wide 2D world with Pop's classic kinds registered: `bullet` ([`Bullet`], priority
+/// CP_BULLET, radius 0.1), `target` (health 3) and `basket` ([`Basket`], priority CP_PLAYER,
+/// radius 2, fixed).
+pub fn classic_world() -> World<DVec2> {
+    let mut world = world2(10.0);
+    let bullet = KindDefaults {
+        priority: CP_BULLET,
+        radius: 0.1,
+        ..KindDefaults::default()
+    };
+    register(&mut world, "bullet", bullet, Rc::new(Bullet));
+    let target = KindDefaults {
+        health: 3.0,
+        ..KindDefaults::default()
+    };
+    register(&mut world, "target", target, Rc::new(()));
+    let basket = KindDefaults {
+        priority: CP_PLAYER,
+        radius: 2.0,
+        fixed: true,
+        ..KindDefaults::default()
+    };
+    register(&mut world, "basket", basket, Rc::new(Basket));
+    world
 }
 
 /// Pop's bullet: touching a critter of kind `target` (or a kind extending it) damages it by 1

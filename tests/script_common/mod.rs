@@ -1,6 +1,7 @@
 //! Helpers for the script tests: scratch folders for inline scripts, loading and stepping scenes,
 //! finding critters by a `tag` property, reading properties, and the laws the checks compare
-//! against (Pop's 1-D elastic formula, tolerances that say what they compared).
+//! against (Pop's 1-D elastic formula and `assert_close`, shared with the engine's tests in
+//! `tests/common`; a 2D `assert_close_vec`).
 //!
 //! Each test file uses only some of these, hence the `dead_code` allowance.
 #![allow(dead_code)]
@@ -10,6 +11,12 @@ use critterbox::scenes::{AnyWorld, Scene};
 use critterbox::script::{load_scene, ScriptOptions};
 use critterbox::{CritterId, Error, PropValue, ScriptError, World};
 use std::path::{Path, PathBuf};
+
+#[path = "../common/mod.rs"]
+mod common;
+// Not every test file uses them, as with the `dead_code` allowance above.
+#[allow(unused_imports)]
+pub use common::{assert_close, pop_elastic};
 
 /// The crate root (tests also run with it as the working directory).
 pub fn crate_root() -> PathBuf {
@@ -190,24 +197,6 @@ pub fn script_error(e: Error) -> ScriptError {
         Error::Script(s) => *s,
         other => panic!("expected a script error, got: {other} ({other:?})"),
     }
-}
-
-/// Pop's 1-D elastic formulas with `mr = m_arg / m_caller`: the normal velocities after the hit.
-pub fn pop_elastic(v1n: f64, v2n: f64, mr: f64) -> (f64, f64) {
-    (
-        ((1.0 - mr) * v1n + 2.0 * mr * v2n) / (1.0 + mr),
-        (2.0 * v1n + (mr - 1.0) * v2n) / (1.0 + mr),
-    )
-}
-
-/// Asserts `|actual - expected| <= tol`, naming the quantity.
-#[track_caller]
-pub fn assert_close(actual: f64, expected: f64, tol: f64, what: &str) {
-    assert!(
-        (actual - expected).abs() <= tol,
-        "{what}: got {actual:e}, want {expected:e} (difference {:e} > tolerance {tol:e})",
-        (actual - expected).abs()
-    );
 }
 
 /// Asserts two 2D vectors agree to `tol` (norm of the difference).
