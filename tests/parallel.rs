@@ -2,7 +2,7 @@
 
 use critterbox::glam::{DVec2, DVec3};
 use critterbox::scenes::{gas, GasParams};
-use critterbox::world::PARALLEL_MIN;
+use critterbox::PARALLEL_MIN;
 use critterbox::{Border, Vector};
 
 fn run_in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
