@@ -4,7 +4,7 @@
 //! ids stay stable and a dead critter's id never names a new one. Iteration is in id order:
 //! deterministic, whatever was added or removed.
 //!
-//! The critters are stored by *slot*. Until [`CritterSet::arrange`] is called a critter's slot is
+//! The critters are stored by *slot*. Until `CritterSet::arrange` is called a critter's slot is
 //! its id's index; `arrange` moves them to other slots (the world lays a large gas out along its
 //! grid, so that critters near each other in space are near each other in memory) and a table
 //! then maps each id to its slot. The engine's passes go in slot order; everything seen from
@@ -183,7 +183,7 @@ impl<V: Vector> CritterSet<V> {
             .then_some(slot)
     }
 
-    /// True once [`CritterSet::arrange`] has put critters in slots other than their ids'.
+    /// True once `CritterSet::arrange` has put critters in slots other than their ids'.
     pub fn is_arranged(&self) -> bool {
         !self.place.is_empty()
     }
@@ -242,7 +242,7 @@ impl<V: Vector> CritterSet<V> {
         self.place = order;
     }
 
-    /// Puts every critter back in the slot its id's index names (undoes [`CritterSet::arrange`]).
+    /// Puts every critter back in the slot its id's index names (undoes `CritterSet::arrange`).
     pub(crate) fn unarrange(&mut self) {
         if self.place.is_empty() {
             return;

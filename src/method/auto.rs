@@ -1,11 +1,11 @@
-//! `auto`: the cheapest method that keeps the scene's tolerances, chosen each step ([`choose`]).
+//! `auto`: the cheapest method that keeps the scene's tolerances, chosen each step (`choose`).
 //!
 //! * **Under gravity** critters come to rest on each other, and the discrete step lets stacks
 //!   sink into themselves, so the step is solved: `solve:8`, with one sweep more per
 //!   [`LAYERS_PER_SWEEP`] layers of a pile deeper than eight sweeps carry, up to
 //!   [`AUTO_MOST_SWEEPS`] ([`Sweeps::ByDepth`]); its islands at rest sleep. So that nothing
 //!   tunnels, the solved step is cut into as many substeps as keep every critter under
-//!   [`SOLVE_FRACTION`] of what would carry it through a wall or a disk ([`tunnel_fraction`]),
+//!   [`SOLVE_FRACTION`] of what would carry it through a wall or a disk (`tunnel_fraction`),
 //!   up to [`MOST_SOLVE_SUBSTEPS`]. A step that would need more is swept (resting contacts are
 //!   the event step's worst case); in a sparse scene (disks cover less than [`SPARSE`] of the
 //!   box) only the critters that are fast or may meet something along their line predict.
@@ -15,7 +15,7 @@
 //!   The one exception is a slow step (no critter moves more than [`SWEEP_FRACTION`] of the
 //!   smallest radius or wall thickness) in a scene where something outside the flight (hooks
 //!   steering critters, critters coming and going) changed more than
-//!   [`crate::method::flight::CHURN`] of the critters since the last step: a kept flight would
+//!   `flight::CHURN` of the critters since the last step: a kept flight would
 //!   predict them all again every step, so such a step is discrete, which does not tunnel at
 //!   that speed, until the next step where a flight is set up on schedule.
 //!
@@ -82,7 +82,7 @@ pub struct Choice {
 pub enum Why {
     /// Solved under gravity, in `substeps` substeps.
     Solve {
-        /// The largest [`tunnel_fraction`] of the step.
+        /// The largest `tunnel_fraction` of the step.
         tunnel: f64,
         /// The substeps that keep each under [`SOLVE_FRACTION`].
         substeps: u32,
@@ -174,7 +174,7 @@ impl std::fmt::Display for Why {
 }
 
 /// A step under gravity is solved in as many substeps as keep each substep's
-/// [`tunnel_fraction`] under this.
+/// `tunnel_fraction` under this.
 pub const SOLVE_FRACTION: f64 = 0.5;
 
 /// The most substeps of a solved step; a step that would need more is swept.

@@ -5,7 +5,7 @@
 //! of free disks is a quadratic in time), wall hits (quadratic against a face when no gravity,
 //! conservative advancement on the exact box distance along a parabola), border hits, and cell
 //! crossings (so each critter only looks at its neighbours) are predicted and processed in time
-//! order by [`crate::method::flight`]; each collision is handed to the caller's `collide` hook.
+//! order by the event engine (`method::flight`); each collision is handed to the caller's `collide` hook.
 //! A step advances exactly dt of event time. Without gravity the flight is kept from one step
 //! to the next (its pending events stay queued; only critters changed between the steps predict
 //! again), so a step pays for its events, not for predicting everyone anew. See `flight` for

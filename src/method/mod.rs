@@ -14,7 +14,7 @@
 //!   changing, and `swept` for a step under gravity too fast for solved substeps ([`auto`]).
 //!
 //! Every method keeps Pop's roles: a touching pair is handed to the caller's `collide` hook.
-//! [`flight`] is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
+//! `flight` is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
 //! formulas.
 
 pub mod auto;

@@ -32,7 +32,7 @@
 //! remaining contacts where the hooks left the critters.
 //!
 //! The impulses carried to the next step are the only state the solve keeps
-//! ([`World::contact_impulses`]); recordings write them with every full state, so a run replays
+//! ([`crate::World::contact_impulses`]); recordings write them with every full state, so a run replays
 //! exactly from any recorded state. Under gravity, critters at rest fall asleep and leave the
 //! step until something wakes them ([`crate::method::sleep`]); their contacts' impulses are kept
 //! for then.

@@ -4,7 +4,7 @@
 //! but the motion is swept: the times of impact of disk pairs (closed-form quadratic,
 //! [`crate::method::toi::toi_ball_ball`]) and of disks against walls (the wall box expanded by
 //! the radius: faces, edges, corners, [`crate::method::toi::toi_wall_ball`]) are processed in time
-//! order by the shared event engine ([`crate::method::flight`]): advance the pair to its time of
+//! order by the shared event engine (`method::flight`): advance the pair to its time of
 //! impact, hand it to the caller's `collide` hook, re-predict for the pair's critters. Then one
 //! discrete pass resolves what still touches (resting contacts, spawned overlaps). Where resting
 //! contacts under gravity exhaust the flight's event budget, the rest of the step is taken in

@@ -91,8 +91,7 @@ mod tests {
             ..m
         };
         assert!(slower_step.every() < m.every());
-        // The figures of the model before the broad phase's Verlet list (a step of 95 ns per
-        // critter) gave K = 1200.
+        // A step of 95 ns per critter, with its capture and encoding, gives K = 1200.
         let before = CostModel {
             step: 95.0,
             capture: 19.0,

@@ -300,9 +300,8 @@ impl Recording {
         anyhow::ensure!(
             theirs == super::schema::STATE_HASH,
             "{}: its state hashes were computed by state hash version {theirs}, and this \
-             critterbox computes version {} (critterbox changed how it hashes a state on \
-             2026-12-01 and 2026-12-02), so they cannot be checked; record the run again with \
-             this critterbox",
+             critterbox computes version {}, so they cannot be checked; record the run again \
+             with this critterbox",
             self.path.display(),
             super::schema::STATE_HASH
         );

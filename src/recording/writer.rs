@@ -88,9 +88,7 @@ pub struct Recorder {
 /// simulation thread and rayon's workers get the cores before the recorder does. The recorder
 /// cannot fall behind for long: the queue is bounded, and a full queue makes the simulation
 /// thread wait. Linux only, where nice belongs to a thread (elsewhere it would be the process).
-///
-/// Measured on the 10,000-critter gas (docs/recording-format.md): the default recording's
-/// median cost went from +10.2% to +7.1% of the step in the same 21 interleaved rounds.
+/// docs/recording-format.md has what it saves.
 fn yield_to_the_simulation() {
     #[cfg(target_os = "linux")]
     // SAFETY: setpriority reads its three integer arguments only; `who` 0 is the calling thread.

@@ -16,7 +16,7 @@ use std::rc::Rc;
 use std::sync::Arc;
 
 impl<V: Vector> World<V> {
-    /// Registers a kind (see [`KindSet::register`]).
+    /// Registers a kind (see [`crate::KindSet::register`]).
     pub fn register_kind(
         &mut self,
         name: &str,
