@@ -83,7 +83,7 @@ impl<V: Vector> BroadPhase<V> {
         // objects stay the same size), that is the only pass. On rayon's threads for a large
         // scene, in fixed chunks: a minimum and an indexed map give the same result for any
         // thread count.
-        let parallel = n >= crate::world::PARALLEL_MIN;
+        let parallel = n >= crate::parallel::PARALLEL_MIN;
         let level_from = |s0: f64, w: f64| {
             let mut level = 0usize;
             if w > s0 {
@@ -231,7 +231,7 @@ impl<V: Vector> BroadPhase<V> {
                 level.pairs_within(topo, &forward, &deltas, run, out)
             };
             let m = level.boxes.len();
-            if m >= crate::world::PARALLEL_MIN && rayon::current_num_threads() > 1 {
+            if m >= crate::parallel::PARALLEL_MIN && rayon::current_num_threads() > 1 {
                 use rayon::prelude::*;
                 let runs = level.cell_runs(RUN_OBJECTS);
                 // A few runs at a time, so that the parts waiting to be joined are a slice of

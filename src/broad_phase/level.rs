@@ -436,7 +436,7 @@ impl<V: Vector> Level<V> {
         let known = known.filter(|_| last == (self.dims, self.inv_cell, self.wrap));
         if let Some(known) = &known {
             let parts = rayon::current_num_threads().min(FILL_PARTS);
-            if known.keys.len() >= crate::world::PARALLEL_MIN && parts > 1 {
+            if known.keys.len() >= crate::parallel::PARALLEL_MIN && parts > 1 {
                 self.sort_in_parts(known, parts, pad);
                 return cell;
             }

@@ -321,11 +321,11 @@ impl<V: Vector> BroadPhase<V> {
             }
             self.rebuild_list(objs, topo);
         } else if self.list.sort_wanted && !self.list.sorted {
-            crate::world::sort_pairs(&mut self.list.pairs, objs.slots());
+            crate::pairs::sort_pairs(&mut self.list.pairs, objs.slots());
             self.list.sorted = true;
         }
         self.list.served = self.list.served.saturating_add(1);
-        if objs.slots() >= crate::world::PARALLEL_MIN {
+        if objs.slots() >= crate::parallel::PARALLEL_MIN {
             // Chunks are tested in parallel and joined in order: the same output for any thread
             // count.
             use rayon::prelude::*;
@@ -359,7 +359,7 @@ impl<V: Vector> BroadPhase<V> {
     fn list_still_valid<O: Objects<V> + ?Sized>(&self, objs: &O, topo: &Topology<V>) -> bool {
         let bounds = &self.list.bounds;
         let inside = |(i, b): (usize, &CellBox<V>)| b.holds(topo, objs.object(i).as_ref());
-        if objs.slots() >= crate::world::PARALLEL_MIN {
+        if objs.slots() >= crate::parallel::PARALLEL_MIN {
             use rayon::prelude::*;
             bounds.par_iter().enumerate().all(inside)
         } else {
@@ -401,7 +401,7 @@ impl<V: Vector> BroadPhase<V> {
         buffer.clear();
         buffer.reserve_exact(objs.slots());
         self.list.bounds = buffer;
-        if objs.slots() >= crate::world::PARALLEL_MIN {
+        if objs.slots() >= crate::parallel::PARALLEL_MIN {
             use rayon::prelude::*;
             self.list
                 .bounds
@@ -438,7 +438,7 @@ impl<V: Vector> BroadPhase<V> {
         let out = |i: usize| (!bounds[i].holds(topo, objs.object(i).as_ref())).then_some(i as u32);
         let escaped: Vec<u32> = match known {
             Some(escaped) => escaped,
-            None if n >= crate::world::PARALLEL_MIN => {
+            None if n >= crate::parallel::PARALLEL_MIN => {
                 use rayon::prelude::*;
                 (0..n).into_par_iter().filter_map(out).collect()
             }

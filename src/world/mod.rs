@@ -33,10 +33,6 @@ pub use diagnostics::Diagnostics;
 pub use layout::{Locality, LOCALITY};
 pub use stats::StepStats;
 
-pub(crate) use crate::pairs::sort_pairs;
-/// Re-exported where the tests have long found it.
-pub use crate::parallel::PARALLEL_MIN;
-
 use crate::border::Topology;
 use crate::context::StepEvents;
 use crate::critter::{Critter, CritterId};

@@ -307,7 +307,7 @@ fn a_large_level_sorted_in_parts_is_the_sequential_sort() {
     // finest), so the second build takes every key from the first.
     let objs = random_objs::<DVec2>(
         &mut rng,
-        crate::world::PARALLEL_MIN + 7_000,
+        crate::parallel::PARALLEL_MIN + 7_000,
         300.0,
         0.5,
         2.0,
