@@ -665,13 +665,13 @@ impl<V: Vector> World<V> {
     }
 
     /// Total kinetic energy of the free critters, in four interleaved sums over the slots added
-    /// in order ([`crate::critter_hash::totals`]: the recording's totals have the same bits).
+    /// in order ([`crate::hash::critters::totals`]: the recording's totals have the same bits).
     pub fn kinetic_energy(&self) -> f64 {
-        crate::critter_hash::totals(self.critters.in_id_order()).0
+        crate::hash::critters::totals(self.critters.in_id_order()).0
     }
     /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
-        crate::critter_hash::totals(self.critters.in_id_order()).1
+        crate::hash::critters::totals(self.critters.in_id_order()).1
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
@@ -712,11 +712,11 @@ impl<V: Vector> World<V> {
         for w in self.rng.state() {
             h.word(w);
         }
-        // Every critter's fields in lanes (src/critter_hash.rs), the rarely changing ones reused
+        // Every critter's fields in lanes (src/hash/critters.rs), the rarely changing ones reused
         // from the last hash when nothing could have written them; properties go to a hasher of
         // their own, after their owner's id.
-        const _: () = assert!(crate::critter_hash::LANES.is_multiple_of(LANES));
-        let pass = crate::critter_hash::hash_critters(
+        const _: () = assert!(crate::hash::critters::LANES.is_multiple_of(LANES));
+        let pass = crate::hash::critters::hash_critters(
             self.critters.in_id_order(),
             self.critters.statics(),
         );
@@ -2416,8 +2416,8 @@ mod layout_tests {
         let plain = CritterSet::from_parts(set.iter().cloned().collect(), &free).expect("parts");
         assert!(!plain.is_arranged());
         let (a, b) = (
-            crate::critter_hash::hash_critters(set.in_id_order(), set.statics()),
-            crate::critter_hash::hash_critters(plain.in_id_order(), plain.statics()),
+            crate::hash::critters::hash_critters(set.in_id_order(), set.statics()),
+            crate::hash::critters::hash_critters(plain.in_id_order(), plain.statics()),
         );
         assert_eq!((a.lanes, a.props), (b.lanes, b.props), "{what}: hash");
         assert_eq!(

@@ -40,7 +40,7 @@ pub const RECOVERED: &str = "critterbox.recovered";
 /// Value of the `format` metadata key.
 pub const FORMAT: &str = "critterbox-recording/1";
 /// Value of the `state_hash` metadata key: which state hash the file's hashes were computed
-/// with (`src/critter_hash.rs`). Files without the key used version 1; version 2 (2026-12-01)
+/// with (`src/hash/critters.rs`). Files without the key used version 1; version 2 (2026-12-01)
 /// put each critter's sixteen words through one set of sixteen lanes; version 3 (2026-12-02)
 /// puts the first eight words through four interleaved sets, and sums the totals the same way.
 pub const STATE_HASH: &str = "3";
