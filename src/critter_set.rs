@@ -12,7 +12,7 @@
 //! stored never shows.
 
 use crate::critter::{Critter, CritterId, Traits};
-use crate::critter_hash::Statics;
+use crate::hash::critters::Statics;
 use crate::vector::Vector;
 use std::sync::Arc;
 

@@ -27,7 +27,6 @@ pub mod broad_phase;
 pub mod contact;
 pub mod context;
 pub mod critter;
-pub mod critter_hash;
 pub mod critter_set;
 pub mod error;
 pub mod hash;
@@ -42,8 +41,6 @@ pub mod rng;
 pub mod rules;
 pub mod scenes;
 pub mod script;
-pub mod stability;
-
 pub mod vector;
 #[cfg(feature = "rerun")]
 pub mod viewer;

@@ -10,8 +10,8 @@ use critterbox::glam::DVec2;
 use critterbox::kind::{KindDefaults, KindHooks};
 use critterbox::method::auto::{AUTO_MOST_SWEEPS, AUTO_SWEEPS};
 use critterbox::method::solve::LAYERS_PER_SWEEP;
+use critterbox::scenes::stress::pile;
 use critterbox::scenes::{gas, GasParams};
-use critterbox::stability::pile;
 use critterbox::wall::WallBox;
 use critterbox::{Border, CritterSpec, Error, Method, World, WorldConfig};
 use std::rc::Rc;
@@ -193,7 +193,7 @@ fn a_kind_s_own_collide_is_called_and_the_rest_are_solved() {
 /// moves as discrete does), and Newton's cradle spreads its momentum instead of passing it on.
 #[test]
 fn solve_tunnels_as_discrete_does_and_spreads_the_cradle_s_momentum() {
-    use critterbox::stability::{first_tunnelling_speed, STRESS};
+    use critterbox::scenes::stress::{first_tunnelling_speed, STRESS};
     let m = Method::Solve(8);
     assert_eq!(
         first_tunnelling_speed(m).unwrap(),
@@ -284,9 +284,9 @@ fn side_walls_and_level_contacts_carry_no_weight() {
     assert_eq!(w.stats().sweeps, u64::from(AUTO_SWEEPS));
 }
 
-/// `critterbox::stability::pile` (rows of 9 balls of radius 0.5, e = 0.5, stacked hexagonally a
-/// hair apart in a well 10 wide) under `method` with sleep on: the step by which every ball is
-/// asleep (None if not by `limit`), and the deepest overlap then, in radii.
+/// `critterbox::scenes::stress::pile` (rows of 9 balls of radius 0.5, e = 0.5, stacked
+/// hexagonally a hair apart in a well 10 wide) under `method` with sleep on: the step by which
+/// every ball is asleep (None if not by `limit`), and the deepest overlap then, in radii.
 fn well_pile(method: Method, rows: usize, limit: u64) -> (Option<u64>, f64) {
     let r = 0.5;
     let mut w = pile(method, rows, DT).unwrap();

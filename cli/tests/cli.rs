@@ -141,6 +141,27 @@ fn help_explains_the_run_options() {
     }
 }
 
+/// `critterbox stability --bullets` is documented in the subcommand's help and prints the
+/// bullet sweep: a row per speed (1 to 1e6, four per decade), in 2D and in 3D.
+#[test]
+fn stability_prints_the_bullet_sweep_on_request() {
+    let help = critterbox(&["stability", "--help"]);
+    assert!(help.status.success());
+    assert!(stdout(&help).contains("--bullets"), "{}", stdout(&help));
+    let o = critterbox(&["stability", "--bullets"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let speed_rows = out
+        .lines()
+        .filter(|l| {
+            l.strip_prefix("| ")
+                .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+        })
+        .count();
+    assert_eq!(speed_rows, 2 * 25, "{out}");
+    assert_eq!(out.lines().filter(|l| l.contains("ends past")).count(), 2);
+}
+
 #[test]
 fn every_shipped_scene_script_runs_from_the_command_line() {
     let dir = std::path::Path::new(ROOT).join("scripts/scenes");

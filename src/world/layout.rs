@@ -179,8 +179,8 @@ mod tests {
         let plain = CritterSet::from_parts(set.iter().cloned().collect(), &free).expect("parts");
         assert!(!plain.is_arranged());
         let (a, b) = (
-            crate::critter_hash::hash_critters(set.in_id_order(), set.statics()),
-            crate::critter_hash::hash_critters(plain.in_id_order(), plain.statics()),
+            crate::hash::critters::hash_critters(set.in_id_order(), set.statics()),
+            crate::hash::critters::hash_critters(plain.in_id_order(), plain.statics()),
         );
         assert_eq!((a.lanes, a.props), (b.lanes, b.props), "{what}: hash");
         assert_eq!(

@@ -251,13 +251,13 @@ impl<V: Vector> World<V> {
         self.methods.collision_virial()
     }
     /// Total kinetic energy of the free critters, in four interleaved sums over the slots added
-    /// in order ([`crate::critter_hash::totals`]: the recording's totals have the same bits).
+    /// in order ([`crate::hash::critters::totals`]: the recording's totals have the same bits).
     pub fn kinetic_energy(&self) -> f64 {
-        crate::critter_hash::totals(self.state.critters.in_id_order()).0
+        crate::hash::critters::totals(self.state.critters.in_id_order()).0
     }
     /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
-        crate::critter_hash::totals(self.state.critters.in_id_order()).1
+        crate::hash::critters::totals(self.state.critters.in_id_order()).1
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {

@@ -24,11 +24,11 @@ impl<V: Vector> World<V> {
         for w in self.state.rng.state() {
             h.word(w);
         }
-        // Every critter's fields in lanes (src/critter_hash.rs), the rarely changing ones reused
+        // Every critter's fields in lanes (src/hash/critters.rs), the rarely changing ones reused
         // from the last hash when nothing could have written them; properties go to a hasher of
         // their own, after their owner's id.
-        const _: () = assert!(crate::critter_hash::LANES.is_multiple_of(LANES));
-        let pass = crate::critter_hash::hash_critters(
+        const _: () = assert!(crate::hash::critters::LANES.is_multiple_of(LANES));
+        let pass = crate::hash::critters::hash_critters(
             self.state.critters.in_id_order(),
             self.state.critters.statics(),
         );

@@ -6,8 +6,8 @@
 
 use anyhow::Context;
 use clap::Args;
-use critterbox::method::Method;
-use critterbox::stability::{chart_pile_points, chart_points, ChartPoint};
+use critterbox::scenes::chart::{chart_pile_points, chart_points, ChartPoint};
+use critterbox::scenes::stress::METHODS;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::io::Write;
@@ -26,15 +26,6 @@ pub struct ChartArgs {
     )]
     pub font: PathBuf,
 }
-
-const METHODS: [Method; 6] = [
-    Method::Discrete,
-    Method::Substep(4),
-    Method::Swept,
-    Method::Event,
-    Method::Solve(8),
-    Method::Auto,
-];
 
 /// Each method's colour, in the order of [`METHODS`].
 const COLOURS: [RGBColor; 6] = [

@@ -1,202 +1,16 @@
-//! Built-in scenes, each written once and used by the CLI, tests and benchmarks.
+//! The built-in scenes of `critterbox run NAME`, and the standard gas the benchmarks measure.
 
+use super::{AnyWorld, Scene};
 use crate::border::Border;
-use crate::critter::CritterSpec;
+use crate::critter::{CritterId, CritterSpec};
 use crate::error::Error;
 use crate::kind::KindDefaults;
 use crate::vector::Vector;
 use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
-use crate::world::{StepStats, World, WorldConfig};
+use crate::world::{World, WorldConfig};
 use crate::BroadPhaseMode;
 use glam::{DVec2, DVec3};
-use std::collections::BTreeMap;
 use std::f64::consts::PI;
-
-/// A world of either dimension, for code that runs any scene.
-pub enum AnyWorld {
-    /// A 2D world.
-    D2(World<DVec2>),
-    /// A 3D world.
-    D3(World<DVec3>),
-}
-
-macro_rules! both {
-    ($self:expr, $w:ident => $body:expr) => {
-        match $self {
-            AnyWorld::D2($w) => $body,
-            AnyWorld::D3($w) => $body,
-        }
-    };
-}
-
-impl AnyWorld {
-    /// 2 or 3.
-    pub fn dim(&self) -> usize {
-        match self {
-            AnyWorld::D2(_) => 2,
-            AnyWorld::D3(_) => 3,
-        }
-    }
-    /// One step.
-    pub fn step(&mut self) -> Result<(), Error> {
-        both!(self, w => w.step())
-    }
-    /// Steps taken.
-    pub fn step_count(&self) -> u64 {
-        both!(self, w => w.step_count())
-    }
-
-    /// The seed of the world's random generator.
-    pub fn seed(&self) -> u64 {
-        both!(self, w => w.seed())
-    }
-    /// The collision method.
-    pub fn method(&self) -> crate::method::Method {
-        both!(self, w => w.method())
-    }
-    /// Changes the collision method.
-    pub fn set_method(&mut self, m: crate::method::Method) -> Result<(), Error> {
-        both!(self, w => w.set_method(m))
-    }
-    /// Sets when the critters are laid out in memory (see [`crate::world::Locality`]).
-    pub fn set_locality(&mut self, locality: crate::world::Locality) {
-        both!(self, w => w.set_locality(locality))
-    }
-    /// True while the critters are stored elsewhere than their ids' slots.
-    pub fn is_laid_out(&self) -> bool {
-        both!(self, w => w.critters().is_arranged())
-    }
-    /// What `auto` chose for the last step, and why.
-    pub fn auto_choice(&self) -> Option<(crate::method::Method, crate::method::auto::Why)> {
-        both!(self, w => w.auto_choice())
-    }
-    /// How many critters sleep (under `solve:n`, [`crate::method::sleep`]).
-    pub fn sleepers(&self) -> usize {
-        both!(self, w => w.sleepers())
-    }
-    /// True when critters may sleep under `solve:n`.
-    pub fn sleep_allowed(&self) -> bool {
-        both!(self, w => w.sleep_allowed())
-    }
-    /// Simulated time.
-    pub fn time(&self) -> f64 {
-        both!(self, w => w.time())
-    }
-    /// Time step.
-    pub fn dt(&self) -> f64 {
-        both!(self, w => w.dt())
-    }
-    /// Number of critters (walls included).
-    pub fn len(&self) -> usize {
-        both!(self, w => w.critters().len())
-    }
-    /// True when the world has no critters.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-    /// Kinetic energy of the free critters.
-    pub fn kinetic_energy(&self) -> f64 {
-        both!(self, w => w.kinetic_energy())
-    }
-    /// Momentum as `[x, y, z]` (z = 0 in 2D).
-    pub fn momentum(&self) -> [f64; 3] {
-        both!(self, w => w.momentum().to_array3())
-    }
-    /// Live critters by kind name.
-    pub fn count_by_kind(&self) -> BTreeMap<String, usize> {
-        both!(self, w => w.count_by_kind())
-    }
-    /// State hash (see [`World::state_hash`]).
-    pub fn state_hash(&self) -> u64 {
-        both!(self, w => w.state_hash())
-    }
-    /// Stats of the last step.
-    pub fn stats(&self) -> &StepStats {
-        both!(self, w => w.stats())
-    }
-    /// Stats summed over all steps.
-    pub fn totals(&self) -> &StepStats {
-        both!(self, w => w.totals())
-    }
-    /// The border rule.
-    pub fn border(&self) -> Border {
-        both!(self, w => w.topology().border)
-    }
-    /// How the engine's caches and layouts have behaved (see [`crate::World::diagnostics`]).
-    pub fn diagnostics(&self) -> crate::world::Diagnostics<'_> {
-        both!(self, w => w.diagnostics())
-    }
-    /// Changes the time step.
-    pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
-        both!(self, w => w.set_dt(dt))
-    }
-    /// Log lines of the last step.
-    pub fn log(&self) -> &[String] {
-        both!(self, w => &w.events().log)
-    }
-}
-
-/// A script file that a run used, kept so a recording can hold everything needed to rerun it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SourceFile {
-    /// The path it was loaded from.
-    pub path: String,
-    /// Its text as loaded (after `--set` overrides).
-    pub text: String,
-}
-
-/// A scene's own step-by-step logic: runs after each step; `Some(reason)` asks the run to stop.
-pub type OnStep = Box<dyn FnMut(&mut AnyWorld) -> Result<Option<String>, Error>>;
-
-/// A world ready to run, with what the scene adds around it.
-pub struct Scene {
-    /// Name (a built-in scene's name, or a script's file stem).
-    pub name: String,
-    /// The world.
-    pub world: AnyWorld,
-    /// Steps to run when none are asked for.
-    pub default_steps: u64,
-    /// The scene's `on_step`, if it has one.
-    pub on_step: Option<OnStep>,
-    /// Script files used (empty for built-in scenes).
-    pub sources: Vec<SourceFile>,
-    /// Every script file loaded so far from the `n`-th on, kinds loaded during the run included
-    /// (set for script scenes).
-    pub(crate) loaded_since: Option<Box<dyn Fn(usize) -> Vec<SourceFile>>>,
-}
-
-impl Scene {
-    /// A scene of `world` with no script around it.
-    pub fn new(name: impl Into<String>, world: AnyWorld, default_steps: u64) -> Self {
-        Scene {
-            name: name.into(),
-            world,
-            default_steps,
-            on_step: None,
-            sources: Vec::new(),
-            loaded_since: None,
-        }
-    }
-
-    /// The script files loaded so far, from the `n`-th on: `sources` and then any kind the
-    /// scene loaded while running (from `on_step`). Empty for built-in scenes.
-    pub fn sources_since(&self, n: usize) -> Vec<SourceFile> {
-        match &self.loaded_since {
-            Some(f) => f(n),
-            None => self.sources.get(n..).map(<[_]>::to_vec).unwrap_or_default(),
-        }
-    }
-
-    /// One step of the world, then the scene's `on_step`. Returns the reason when the scene asks
-    /// to stop.
-    pub fn step(&mut self) -> Result<Option<String>, Error> {
-        self.world.step()?;
-        match &mut self.on_step {
-            Some(f) => f(&mut self.world),
-            None => Ok(None),
-        }
-    }
-}
 
 /// Builds the built-in scene `name` as a [`Scene`].
 pub fn builtin(name: &str, params: &SceneParams) -> Result<Scene, Error> {
@@ -424,18 +238,6 @@ where
     Ok(gas::<V>(&params)?.into())
 }
 
-impl From<World<DVec2>> for AnyWorld {
-    fn from(w: World<DVec2>) -> Self {
-        AnyWorld::D2(w)
-    }
-}
-
-impl From<World<DVec3>> for AnyWorld {
-    fn from(w: World<DVec3>) -> Self {
-        AnyWorld::D3(w)
-    }
-}
-
 fn walled_box(world: &mut World<DVec2>, w: f64, h: f64) -> Result<(), Error> {
     let t = DEFAULT_WALL_THICKNESS;
     world.add_wall(WallBox::aligned(
@@ -484,24 +286,40 @@ fn billiards(p: &SceneParams) -> Result<AnyWorld, Error> {
 }
 
 fn cradle(p: &SceneParams) -> Result<AnyWorld, Error> {
-    let r = 0.5;
     let n = p.n.unwrap_or(5);
     let config = WorldConfig::new(
         DVec2::ZERO,
-        DVec2::new(10.0 + 2.0 * r * n as f64 + 10.0, 4.0),
+        DVec2::new(10.0 + 2.0 * CRADLE_RADIUS * n as f64 + 10.0, 4.0),
     )
     .dt(p.dt.unwrap_or(1.0 / 60.0))
     .seed(p.seed);
     let mut world = World::new(config)?;
-    world.spawn(
-        CritterSpec::ball(DVec2::new(2.0, 2.0))
-            .vel(DVec2::new(1.0, 0.0))
-            .radius(r),
-    )?;
-    for i in 0..n {
-        world.spawn(CritterSpec::ball(DVec2::new(5.0 + 2.0 * r * i as f64, 2.0)).radius(r))?;
-    }
+    spawn_cradle(&mut world, n)?;
     Ok(world.into())
+}
+
+/// Radius of the cradle's balls.
+const CRADLE_RADIUS: f64 = 0.5;
+
+/// Newton's cradle along x, at height 2 (and depth 2 in 3D): a striker at x = 2 moving at 1
+/// towards `n` touching balls from x = 5 on, all of radius [`CRADLE_RADIUS`]. The ids, striker
+/// first.
+pub(super) fn spawn_cradle<V: Vector>(
+    world: &mut World<V>,
+    n: usize,
+) -> Result<Vec<CritterId>, Error> {
+    let r = CRADLE_RADIUS;
+    let at = |x: f64| {
+        let mut p = V::splat(2.0);
+        p.set(0, x);
+        p
+    };
+    let striker = CritterSpec::ball(at(2.0)).vel(V::unit_x()).radius(r);
+    let mut ids = vec![world.spawn(striker)?];
+    for i in 0..n {
+        ids.push(world.spawn(CritterSpec::ball(at(5.0 + 2.0 * r * i as f64)).radius(r))?);
+    }
+    Ok(ids)
 }
 
 fn pegs(p: &SceneParams) -> Result<AnyWorld, Error> {

@@ -4,10 +4,18 @@
 //! instead of waiting on each other, and the lanes are combined at the end. Each lane update
 //! `(h.rotate_left(5) ^ w) * K` is a bijection of `h` for a fixed `w` and of `w` for a fixed `h`,
 //! so a change in any one word always changes that lane's state. The critters' fields, the bulk
-//! of a world's state, have a pass of their own with the same update (`src/critter_hash.rs`);
-//! this hasher takes the world's few other words and that pass's lanes.
+//! of a world's state, have a pass of their own with the same update ([`critters`], on AVX-512
+//! where the CPU has it); this hasher takes the world's few other words and that pass's lanes.
 
-/// The odd multiplier of every lane.
+pub mod critters;
+
+#[cfg(target_arch = "x86_64")]
+mod avx512;
+
+#[cfg(test)]
+mod tests;
+
+/// The odd multiplier of every lane (here and in [`critters`]).
 const K: u64 = 0x5851_F42D_4C95_7F2D;
 
 /// Hashes 64-bit words. Not cryptographic: it exists to notice that two runs differ.
@@ -64,51 +72,20 @@ impl StateHasher {
         for &lane in &self.lanes[1..] {
             z = mix(z, lane);
         }
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        scramble(z)
     }
 }
 
-#[inline]
+/// One lane's update: a bijection of `h` for a fixed `w`, and of `w` for a fixed `h`.
+#[inline(always)]
 fn mix(h: u64, w: u64) -> u64 {
     (h.rotate_left(5) ^ w).wrapping_mul(K)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn one_bit_changes_the_hash() {
-        let mut a = StateHasher::default();
-        let mut b = StateHasher::default();
-        a.float(1.0);
-        b.float(f64::from_bits(1.0f64.to_bits() ^ 1));
-        assert_ne!(a.finish(), b.finish());
-        let mut c = StateHasher::default();
-        c.float(0.0);
-        let mut d = StateHasher::default();
-        d.float(-0.0);
-        assert_ne!(c.finish(), d.finish());
-    }
-
-    #[test]
-    fn every_bit_of_every_lane_counts() {
-        let base = [1u64, 2, 3, 4, 5, 6, 7, 8];
-        let hash = |w: [u64; LANES]| {
-            let mut h = StateHasher::default();
-            h.words(w);
-            h.words(base);
-            h.finish()
-        };
-        let h0 = hash(base);
-        for lane in 0..LANES {
-            for bit in 0..64 {
-                let mut w = base;
-                w[lane] ^= 1 << bit;
-                assert_ne!(hash(w), h0, "lane {lane} bit {bit}");
-            }
-        }
-    }
+/// splitmix64's finaliser: nearby inputs give unrelated outputs.
+#[inline]
+const fn scramble(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
