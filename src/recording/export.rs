@@ -2,7 +2,8 @@
 //! state and one per event, with floats in shortest round-trip form (they read back exactly).
 
 use super::capture;
-use super::reader::{decode, read_items, Flow, Item, Recording};
+use super::error::RecordingError;
+use super::reader::{decode, decode_state, read_items, Flow, Item, Recording};
 use super::replay::Replay;
 use super::schema::{
     self, id_of, CollisionsMsg, HashMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg,
@@ -31,10 +32,12 @@ struct Csv {
 }
 
 impl Csv {
-    fn create(dir: &Path, name: &str, header: &[&str]) -> anyhow::Result<Csv> {
+    fn create(dir: &Path, name: &str, header: &[&str]) -> Result<Csv, RecordingError> {
         let path = dir.join(name);
-        let file = File::create(&path)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?;
+        let file = File::create(&path).map_err(|error| RecordingError::CannotCreate {
+            path: path.clone(),
+            error,
+        })?;
         let mut out = BufWriter::with_capacity(1 << 20, file);
         writeln!(out, "{}", header.join(","))?;
         Ok(Csv {
@@ -80,7 +83,7 @@ impl Csv {
         self.rows += 1;
         Ok(())
     }
-    fn finish(mut self) -> anyhow::Result<(PathBuf, u64)> {
+    fn finish(mut self) -> std::io::Result<(PathBuf, u64)> {
         self.out.flush()?;
         Ok((self.path, self.rows))
     }
@@ -133,9 +136,15 @@ fn state_rows(csv: &mut Csv, s: &StateMsg) -> std::io::Result<()> {
 /// Writes `states.csv`, `steps.csv`, `collisions.csv`, `lifecycle.csv` and `log.csv` into `dir`.
 /// With `every_step`, states.csv has every step, re-simulated between the keyframes (and
 /// checked against every recorded hash); otherwise the recorded full states.
-pub fn export_csv(rec: &Recording, dir: &Path, every_step: bool) -> anyhow::Result<Exported> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+pub fn export_csv(
+    rec: &Recording,
+    dir: &Path,
+    every_step: bool,
+) -> Result<Exported, RecordingError> {
+    std::fs::create_dir_all(dir).map_err(|error| RecordingError::CannotCreate {
+        path: dir.to_path_buf(),
+        error,
+    })?;
     let dim = rec.meta().dim;
     let z = |h: &mut Vec<&'static str>, at: usize, name: &'static str| {
         if dim == 3 {
@@ -168,9 +177,7 @@ pub fn export_csv(rec: &Recording, dir: &Path, every_step: bool) -> anyhow::Resu
         };
         match topic {
             schema::STATE if !every_step => {
-                let s: StateMsg = decode(topic, data)?;
-                s.check()
-                    .map_err(|e| anyhow::anyhow!("the state of step {}: {e}", s.step))?;
+                let s = decode_state(data)?;
                 state_rows(&mut states, &s)?;
                 out.states += 1;
             }
@@ -250,14 +257,10 @@ pub fn export_csv(rec: &Recording, dir: &Path, every_step: bool) -> anyhow::Resu
     if every_step {
         let mut replay = Replay::new(rec)?;
         let last = rec.last_step();
-        let mut write = |world: &crate::scenes::AnyWorld| -> anyhow::Result<()> {
+        let mut write = |world: &crate::scenes::AnyWorld| -> Result<(), RecordingError> {
             let s = world.step_count();
-            if let Some(&h) = rec.hashes.get(&s) {
-                anyhow::ensure!(
-                    world.state_hash() == h,
-                    "the replay diverged from the recording at step {s}; run `critterbox \
-                     replay --verify` (the states written so far are exact)"
-                );
+            if rec.hashes.get(&s).is_some_and(|&h| world.state_hash() != h) {
+                return Err(RecordingError::ExportDiverged { step: s });
             }
             state_rows(&mut states, &capture::any_state(world))?;
             out.states += 1;

@@ -17,6 +17,7 @@
 
 pub mod capture;
 pub mod compare;
+mod error;
 pub mod export;
 pub mod foxglove;
 pub mod keyframes;
@@ -30,6 +31,7 @@ pub mod schema;
 pub mod verify;
 pub mod writer;
 
+pub use error::RecordingError;
 pub use meta::{EndMeta, RunMeta, RunOverrides, SceneSource};
 pub use reader::Recording;
 pub use writer::{Recorder, Written};

@@ -2,6 +2,7 @@
 //! cut short: everything up to the last complete chunk comes back, and the reason reading
 //! stopped is kept. (The summary-based reader needs the footer, which a killed run never wrote.)
 
+use super::error::{with_causes, RecordingError};
 use super::meta::{EndMeta, RunMeta};
 use super::schema::{self, ErrorMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -9,41 +10,6 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
-
-/// Why a recording could not be read at all.
-#[derive(Debug, thiserror::Error)]
-pub enum ReadError {
-    /// The file could not be opened or read.
-    #[error("cannot read {path}: {message}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
-    /// Not an MCAP file.
-    #[error("{path} is not an MCAP file (it does not start with the MCAP magic bytes)")]
-    NotMcap {
-        /// The file.
-        path: PathBuf,
-    },
-    /// An MCAP file, but not one critterbox wrote.
-    #[error("{path} is an MCAP file but not a critterbox recording: {reason}")]
-    NotCritterbox {
-        /// The file.
-        path: PathBuf,
-        /// What is missing.
-        reason: String,
-    },
-    /// A critterbox recording too damaged to use.
-    #[error("{path} is damaged: {reason}")]
-    Corrupt {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        reason: String,
-    },
-}
 
 /// One record of a recording, as the reader meets them.
 pub enum Item<'a> {
@@ -126,9 +92,9 @@ const RECORD_LIMIT: usize = 1 << 30;
 /// ones end reading with [`ReadEnd::truncated`] set.
 pub fn read_items(
     path: &Path,
-    mut visit: impl FnMut(Item<'_>) -> anyhow::Result<Flow>,
-) -> anyhow::Result<ReadEnd> {
-    let io = |e: std::io::Error| ReadError::Io {
+    mut visit: impl FnMut(Item<'_>) -> Result<Flow, RecordingError>,
+) -> Result<ReadEnd, RecordingError> {
+    let io = |e: std::io::Error| RecordingError::CannotRead {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
@@ -136,10 +102,9 @@ pub fn read_items(
     let mut magic = [0u8; 8];
     let got = read_full(&mut file, &mut magic).map_err(io)?;
     if got < magic.len() || magic != *mcap::MAGIC {
-        return Err(ReadError::NotMcap {
+        return Err(RecordingError::NotMcap {
             path: path.to_path_buf(),
-        }
-        .into());
+        });
     }
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
@@ -251,9 +216,36 @@ fn describe(e: &mcap::McapError) -> String {
     }
 }
 
-/// Decodes a JSON message of `topic`, naming the topic and step on failure.
-pub fn decode<T: serde::de::DeserializeOwned>(topic: &str, data: &[u8]) -> anyhow::Result<T> {
-    serde_json::from_slice(data).map_err(|e| anyhow::anyhow!("a {topic} message is not valid: {e}"))
+/// Decodes a JSON message of `topic`, naming the topic on failure.
+pub fn decode<T: serde::de::DeserializeOwned>(
+    topic: &str,
+    data: &[u8],
+) -> Result<T, RecordingError> {
+    serde_json::from_slice(data).map_err(|error| RecordingError::BadMessage {
+        topic: topic.to_string(),
+        error,
+    })
+}
+
+/// Decodes a full state message and checks that its columns fit together.
+pub fn decode_state(data: &[u8]) -> Result<StateMsg, RecordingError> {
+    let state: StateMsg = decode(schema::STATE, data)?;
+    state.check().map_err(|reason| RecordingError::BadState {
+        step: state.step,
+        reason,
+    })?;
+    Ok(state)
+}
+
+/// True for the errors that say the file as a whole cannot be read as a recording (as opposed
+/// to one damaged message in it).
+fn is_about_the_file(e: &RecordingError) -> bool {
+    matches!(
+        e,
+        RecordingError::CannotRead { .. }
+            | RecordingError::NotMcap { .. }
+            | RecordingError::NotCritterbox { .. }
+    )
 }
 
 /// What `replay`, `inspect`, `diff` and `export` need from a recording, read in one pass (full
@@ -295,21 +287,20 @@ pub struct Recording {
 impl Recording {
     /// An error, saying what to do, if the file's state hashes were computed by another state
     /// hash than this critterbox's (then no recorded hash can match a replayed one).
-    pub fn check_state_hash(&self) -> anyhow::Result<()> {
+    pub fn check_state_hash(&self) -> Result<(), RecordingError> {
         let theirs = self.meta_map.get("state_hash").map_or("1", String::as_str);
-        anyhow::ensure!(
-            theirs == super::schema::STATE_HASH,
-            "{}: its state hashes were computed by state hash version {theirs}, and this \
-             critterbox computes version {}, so they cannot be checked; record the run again \
-             with this critterbox",
-            self.path.display(),
-            super::schema::STATE_HASH
-        );
+        if theirs != schema::STATE_HASH {
+            return Err(RecordingError::OtherStateHash {
+                path: self.path.clone(),
+                theirs: theirs.to_string(),
+                ours: schema::STATE_HASH,
+            });
+        }
         Ok(())
     }
 
     /// Reads a recording; a file that is not one is a clear error.
-    pub fn open(path: &Path) -> anyhow::Result<Recording> {
+    pub fn open(path: &Path) -> Result<Recording, RecordingError> {
         let mut rec = Recording {
             path: path.to_path_buf(),
             ..Recording::default()
@@ -319,7 +310,7 @@ impl Recording {
                 Item::Metadata { name, map } if name == schema::META => {
                     rec.meta_map = map.clone();
                     rec.meta = Some(RunMeta::from_map(map).map_err(|reason| {
-                        ReadError::NotCritterbox {
+                        RecordingError::NotCritterbox {
                             path: path.to_path_buf(),
                             reason,
                         }
@@ -339,12 +330,11 @@ impl Recording {
                 }
                 Item::Message { topic, data, .. } => {
                     if rec.meta.is_none() {
-                        return Err(ReadError::NotCritterbox {
+                        return Err(RecordingError::NotCritterbox {
                             path: path.to_path_buf(),
                             reason: "it has no 'critterbox' metadata record before its messages"
                                 .into(),
-                        }
-                        .into());
+                        });
                     }
                     *rec.messages.entry(topic.to_string()).or_insert(0) += 1;
                     rec.take(topic, data)?;
@@ -356,8 +346,8 @@ impl Recording {
         let end = match end {
             Ok(end) => end,
             // A damaged message in an otherwise readable file: keep what came before.
-            Err(e) if rec.meta.is_some() && e.downcast_ref::<ReadError>().is_none() => ReadEnd {
-                truncated: Some(format!("{e:#}")),
+            Err(e) if rec.meta.is_some() && !is_about_the_file(&e) => ReadEnd {
+                truncated: Some(with_causes(&e)),
                 stopped: true,
             },
             Err(e) => return Err(e),
@@ -367,23 +357,24 @@ impl Recording {
                 Some(t) => format!("no 'critterbox' metadata record could be read ({t})"),
                 None => "it has no 'critterbox' metadata record".to_string(),
             };
-            return Err(ReadError::NotCritterbox {
+            return Err(RecordingError::NotCritterbox {
                 path: path.to_path_buf(),
                 reason,
-            }
-            .into());
+            });
         }
         rec.truncated = end.truncated;
         Ok(rec)
     }
 
-    fn take(&mut self, topic: &str, data: &[u8]) -> anyhow::Result<()> {
+    fn take(&mut self, topic: &str, data: &[u8]) -> Result<(), RecordingError> {
         match topic {
             schema::HASH => {
                 let m: schema::HashMsg = decode(topic, data)?;
-                let hash = u64::from_str_radix(&m.hash, 16).map_err(|_| {
-                    anyhow::anyhow!("a {topic} message has a bad hash '{}'", m.hash)
-                })?;
+                let hash =
+                    u64::from_str_radix(&m.hash, 16).map_err(|_| RecordingError::BadHash {
+                        topic: topic.to_string(),
+                        hash: m.hash.clone(),
+                    })?;
                 self.hashes.insert(m.step, hash);
             }
             schema::TOTALS => self.totals.push(decode(topic, data)?),
@@ -455,14 +446,11 @@ impl Recording {
 /// [`Flow::Stop`].
 pub fn for_each_state(
     path: &Path,
-    mut visit: impl FnMut(StateMsg) -> anyhow::Result<Flow>,
-) -> anyhow::Result<ReadEnd> {
+    mut visit: impl FnMut(StateMsg) -> Result<Flow, RecordingError>,
+) -> Result<ReadEnd, RecordingError> {
     read_items(path, |item| match item {
         Item::Message { topic, data, .. } if topic == schema::STATE => {
-            let state: StateMsg = decode(topic, data)?;
-            state
-                .check()
-                .map_err(|e| anyhow::anyhow!("the state of step {}: {e}", state.step))?;
+            let state = decode_state(data)?;
             visit(state)
         }
         _ => Ok(Flow::Continue),
@@ -470,7 +458,7 @@ pub fn for_each_state(
 }
 
 /// The full state recorded at `step`, if there is one.
-pub fn state_at(path: &Path, step: u64) -> anyhow::Result<Option<StateMsg>> {
+pub fn state_at(path: &Path, step: u64) -> Result<Option<StateMsg>, RecordingError> {
     let mut found = None;
     for_each_state(path, |s| {
         if s.step == step {

@@ -7,11 +7,11 @@
 //! the recording is ever read. A kind a script loaded by path (`load_kind("dir/k.rhai")`) is
 //! pointed at its attached copy.
 
+use super::error::RecordingError;
 use super::meta::SceneSource;
 use super::reader::Recording;
 use crate::scenes::{self, Scene, SceneParams};
 use crate::script::{self, ScriptOptions};
-use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 /// A scene rebuilt from a recording, with the temporary folder its scripts live in (removed when
@@ -61,7 +61,7 @@ fn file_name(path: &str) -> String {
 }
 
 /// Rebuilds the recorded scene at step 0, with the recorded dt override applied.
-pub fn rebuild(rec: &Recording) -> anyhow::Result<Rebuilt> {
+pub fn rebuild(rec: &Recording) -> Result<Rebuilt, RecordingError> {
     let meta = rec.meta();
     let (mut scene, dir) = match &meta.source {
         SceneSource::Builtin => {
@@ -70,31 +70,30 @@ pub fn rebuild(rec: &Recording) -> anyhow::Result<Rebuilt> {
                 seed: meta.seed_override.unwrap_or(meta.seed),
                 dt: meta.dt_override,
             };
-            let scene = scenes::builtin(&meta.scene, &params).with_context(|| {
-                format!(
-                    "rebuilding the built-in scene '{}' (recorded by critterbox {})",
-                    meta.scene, meta.version
-                )
-            })?;
+            let scene =
+                scenes::builtin(&meta.scene, &params).map_err(|error| RecordingError::Builtin {
+                    scene: meta.scene.clone(),
+                    version: meta.version.clone(),
+                    error: Box::new(error),
+                })?;
             (scene, None)
         }
-        SceneSource::Test { case } => anyhow::bail!(
-            "the world of this recording was built by the test {case} (critterbox test \
-             recorded it when the test failed), not by a scene, so it cannot be rebuilt to \
-             verify: replay it without --verify, or run the test again with \
-             `critterbox test FILE --filter NAME`"
-        ),
+        SceneSource::Test { case } => {
+            return Err(RecordingError::BuiltByTest { case: case.clone() })
+        }
         SceneSource::Script { file } => {
-            let dir = TempDir::new("critterbox-replay")
-                .context("making a temporary folder for the recorded scripts")?;
+            let dir = TempDir::new("critterbox-replay").map_err(RecordingError::TempFolder)?;
             let scene = load_script_scene(rec, file, dir.path())?;
             (scene, Some(dir))
         }
     };
-    let method: crate::method::Method = meta
+    let method = meta
         .method
-        .parse()
-        .map_err(|e| anyhow::anyhow!("the recording's method '{}': {e}", meta.method))?;
+        .parse::<crate::method::Method>()
+        .map_err(|reason| RecordingError::Method {
+            method: meta.method.clone(),
+            reason,
+        })?;
     scene.world.set_method(method)?;
     if let Some(dt) = meta.dt_override {
         scene.world.set_dt(dt)?;
@@ -102,18 +101,19 @@ pub fn rebuild(rec: &Recording) -> anyhow::Result<Rebuilt> {
     Ok(Rebuilt { scene, _dir: dir })
 }
 
-fn load_script_scene(rec: &Recording, scene_file: &str, dir: &Path) -> anyhow::Result<Scene> {
+fn load_script_scene(
+    rec: &Recording,
+    scene_file: &str,
+    dir: &Path,
+) -> Result<Scene, RecordingError> {
     let meta = rec.meta();
     let scene_text = rec
         .scripts
         .iter()
         .find(|(name, _)| name == scene_file)
         .map(|(_, text)| text.clone())
-        .with_context(|| {
-            format!(
-                "the recording has no attachment '{scene_file}' (the scene script); it cannot be \
-                 re-simulated"
-            )
+        .ok_or_else(|| RecordingError::NoSceneScript {
+            file: scene_file.to_string(),
         })?;
     let kinds_dir = dir.join("kinds");
     let scenes_dir = dir.join("scenes");
@@ -150,10 +150,8 @@ fn load_script_scene(rec: &Recording, scene_file: &str, dir: &Path) -> anyhow::R
         seed: meta.seed_override,
     };
     // The attached scene text already has the --set values in it.
-    script::load_scene(&scene_path, &[], &options).with_context(|| {
-        format!(
-            "rebuilding the script scene '{}' from the recording's attachments",
-            meta.scene
-        )
+    script::load_scene(&scene_path, &[], &options).map_err(|error| RecordingError::ScriptScene {
+        scene: meta.scene.clone(),
+        error: Box::new(error),
     })
 }

@@ -2,6 +2,7 @@
 //! from a cut-off one (the complete chunks' messages, every attachment and metadata record
 //! before the cut), and tests use the same copy to alter one message.
 
+use super::error::RecordingError;
 use super::reader::{read_items, Flow, Item};
 use super::schema;
 use mcap::records::{MessageHeader, Metadata};
@@ -35,16 +36,18 @@ pub fn rewrite(
     src: &Path,
     dst: &Path,
     mut edit: impl FnMut(&str, &[u8]) -> Option<Vec<u8>>,
-) -> anyhow::Result<Rewritten> {
-    anyhow::ensure!(
-        src.canonicalize().ok() != dst.canonicalize().ok() || !dst.exists(),
-        "the output {} would overwrite the input",
-        dst.display()
-    );
+) -> Result<Rewritten, RecordingError> {
+    if src.canonicalize().ok() == dst.canonicalize().ok() && dst.exists() {
+        return Err(RecordingError::WouldOverwrite {
+            path: dst.to_path_buf(),
+        });
+    }
     // Check it is a recording before creating anything.
     let _ = super::reader::Recording::open(src)?;
-    let file =
-        File::create(dst).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dst.display()))?;
+    let file = File::create(dst).map_err(|error| RecordingError::CannotCreate {
+        path: dst.to_path_buf(),
+        error,
+    })?;
     let mut w = WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .compression_threads(0)

@@ -9,6 +9,7 @@
 
 use super::capture;
 use super::compare::first_difference;
+use super::error::{with_causes, RecordingError};
 use super::reader::{self, Recording};
 use super::rebuild::{rebuild, Rebuilt};
 use super::schema::{id_of, StateMsg};
@@ -19,27 +20,6 @@ use crate::vector::Vector;
 use crate::world::World;
 use std::sync::Arc;
 
-/// Why a replay could not reach a step.
-#[derive(Debug, thiserror::Error)]
-pub enum ReplayError {
-    /// The re-simulated step failed.
-    #[error("the replay failed at step {step}: {message}")]
-    Failed {
-        /// Steps completed before the failure.
-        step: u64,
-        /// The error.
-        message: String,
-    },
-    /// The scene asked to stop before the step.
-    #[error("the scene stopped after step {step} ({reason})")]
-    Stopped {
-        /// Steps taken.
-        step: u64,
-        /// The scene's reason.
-        reason: String,
-    },
-}
-
 /// A recorded run being re-simulated.
 pub struct Replay {
     rebuilt: Rebuilt,
@@ -48,7 +28,7 @@ pub struct Replay {
 
 impl Replay {
     /// The recorded scene at step 0.
-    pub fn new(rec: &Recording) -> anyhow::Result<Replay> {
+    pub fn new(rec: &Recording) -> Result<Replay, RecordingError> {
         Ok(Replay {
             rebuilt: rebuild(rec)?,
             stopped: None,
@@ -65,15 +45,16 @@ impl Replay {
         self.world().step_count()
     }
 
-    /// Steps until `step` steps have been taken, calling `each` after every step.
-    pub fn step_to(
+    /// Steps until `step` steps have been taken, calling `each` after every step; an error of
+    /// `each` stops the replay and is returned as it is.
+    pub fn step_to<E: From<RecordingError>>(
         &mut self,
         step: u64,
-        mut each: impl FnMut(&AnyWorld) -> anyhow::Result<()>,
-    ) -> anyhow::Result<()> {
+        mut each: impl FnMut(&AnyWorld) -> Result<(), E>,
+    ) -> Result<(), E> {
         while self.step_count() < step {
             if let Some(reason) = &self.stopped {
-                return Err(ReplayError::Stopped {
+                return Err(RecordingError::SceneStopped {
                     step: self.step_count(),
                     reason: reason.clone(),
                 }
@@ -82,13 +63,7 @@ impl Replay {
             let at = self.step_count();
             match self.rebuilt.scene.step() {
                 Ok(stop) => self.stopped = stop,
-                Err(e) => {
-                    return Err(ReplayError::Failed {
-                        step: at,
-                        message: e.to_string(),
-                    }
-                    .into())
-                }
+                Err(error) => return Err(RecordingError::StepFailed { step: at, error }.into()),
             }
             each(self.world())?;
         }
@@ -229,12 +204,14 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
 /// The exact state after `step` steps: from the file if it holds that state, else re-simulated
 /// from the nearest recorded full state before it (or from step 0), checked against the
 /// recorded hashes on the way.
-pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, StateSource)> {
+pub fn state_at_step(
+    rec: &Recording,
+    step: u64,
+) -> Result<(StateMsg, StateSource), RecordingError> {
     let last = rec.last_step();
-    anyhow::ensure!(
-        step <= last,
-        "the recording ends at step {last}; there is no step {step}"
-    );
+    if step > last {
+        return Err(RecordingError::NoStep { step, last });
+    }
     if rec.keyframes.contains(&step) {
         if let Some(s) = reader::state_at(&rec.path, step)? {
             return Ok((s, StateSource::Recorded));
@@ -252,18 +229,21 @@ pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, St
             Ok(state) => {
                 return Ok((state, StateSource::Restored { keyframe: k.step }));
             }
-            Err(e) => why_not = Some(format!("{e:#}")),
+            Err(e) => why_not = Some(with_causes(&e)),
         }
     }
     let mut replay = Replay::new(rec)?;
-    let check = |world: &AnyWorld| -> anyhow::Result<()> {
+    let check = |world: &AnyWorld| -> Result<(), RecordingError> {
         let s = world.step_count();
         check_hash(rec, world, step)?;
         if let Some(k) = &key_state {
             if k.step == s {
                 let mine = capture::any_state(world);
-                if let Some(d) = first_difference(k, &mine, "recorded", "replayed") {
-                    anyhow::bail!("the replay differs from the keyframe at step {s}: {d}");
+                if let Some(difference) = first_difference(k, &mine, "recorded", "replayed") {
+                    return Err(RecordingError::DiffersFromKeyframe {
+                        step: s,
+                        difference,
+                    });
                 }
             }
         }
@@ -281,33 +261,38 @@ pub fn state_at_step(rec: &Recording, step: u64) -> anyhow::Result<(StateMsg, St
 }
 
 /// The recorded hash of the world's step, if there is one, equals the world's.
-fn check_hash(rec: &Recording, world: &AnyWorld, target: u64) -> anyhow::Result<()> {
+fn check_hash(rec: &Recording, world: &AnyWorld, target: u64) -> Result<(), RecordingError> {
     rec.check_state_hash()?;
     let s = world.step_count();
-    if let Some(&h) = rec.hashes.get(&s) {
+    if let Some(&recorded) = rec.hashes.get(&s) {
         let got = world.state_hash();
-        anyhow::ensure!(
-            got == h,
-            "the replay diverged from the recording at step {s} (hash {got:016x}, recorded \
-             {h:016x}); step {target} cannot be shown exactly: run `critterbox replay --verify`"
-        );
+        if got != recorded {
+            return Err(RecordingError::Diverged {
+                step: s,
+                got,
+                recorded,
+                shown: target,
+            });
+        }
     }
     Ok(())
 }
 
 /// Step `step`'s state, re-simulated from the recorded full state `key`.
-fn from_keyframe(rec: &Recording, key: &StateMsg, step: u64) -> anyhow::Result<StateMsg> {
+fn from_keyframe(rec: &Recording, key: &StateMsg, step: u64) -> Result<StateMsg, RecordingError> {
     let mut replay = Replay::new(rec)?;
     replay
         .restore(key)
-        .map_err(|e| anyhow::anyhow!("cannot start from the state at step {}: {e}", key.step))?;
+        .map_err(|reason| RecordingError::CannotRestore {
+            step: key.step,
+            reason,
+        })?;
     let at = replay.world().step_count();
-    anyhow::ensure!(
-        rec.hashes.contains_key(&at),
-        "no recorded hash at step {at} to check the restored world against"
-    );
+    if !rec.hashes.contains_key(&at) {
+        return Err(RecordingError::NoHashToCheck { step: at });
+    }
     check_hash(rec, replay.world(), step)
-        .map_err(|e| anyhow::anyhow!("the restored world is not the recorded one: {e:#}"))?;
+        .map_err(|e| RecordingError::RestoredDiffers(Box::new(e)))?;
     replay.step_to(step, |w| check_hash(rec, w, step))?;
     Ok(capture::any_state(replay.world()))
 }

@@ -3,9 +3,10 @@
 
 use super::capture;
 use super::compare::{first_difference, same_json};
-use super::reader::{decode, read_items, Flow, Item, Recording};
+use super::error::{with_causes, RecordingError};
+use super::reader::{decode, decode_state, read_items, Flow, Item, Recording};
 use super::replay::Replay;
-use super::schema::{self, CollisionsMsg, ErrorMsg, HashMsg, LifecycleMsg, LogMsg, StateMsg};
+use super::schema::{self, CollisionsMsg, ErrorMsg, HashMsg, LifecycleMsg, LogMsg};
 
 /// The first place a replay departs from its recording.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,7 +52,10 @@ struct StepOnly {
 }
 
 /// Re-simulates `rec` and compares everything it recorded. `progress` gets the step reached.
-pub fn verify(rec: &Recording, mut progress: impl FnMut(u64)) -> anyhow::Result<VerifyReport> {
+pub fn verify(
+    rec: &Recording,
+    mut progress: impl FnMut(u64),
+) -> Result<VerifyReport, RecordingError> {
     rec.check_state_hash()?;
     let mut replay = Replay::new(rec)?;
     let mut report = VerifyReport {
@@ -74,10 +78,12 @@ pub fn verify(rec: &Recording, mut progress: impl FnMut(u64)) -> anyhow::Result<
         }
         if topic == schema::ERROR {
             let e: ErrorMsg = decode(topic, data)?;
-            if let Err(err) = replay.step_to(e.step.saturating_sub(1), |_| Ok(())) {
+            let before = e.step.saturating_sub(1);
+            let reached: Result<(), RecordingError> = replay.step_to(before, |_| Ok(()));
+            if let Err(err) = reached {
                 report.mismatch = Some(Mismatch {
                     step: replay.step_count(),
-                    what: format!("{err:#}"),
+                    what: with_causes(&err),
                     critter: None,
                 });
                 done = true;
@@ -99,17 +105,21 @@ pub fn verify(rec: &Recording, mut progress: impl FnMut(u64)) -> anyhow::Result<
             done = true;
             return Ok(Flow::Stop);
         }
-        if let Err(err) = replay.step_to(step, |w| {
+        let reached: Result<(), RecordingError> = replay.step_to(step, |w| {
             progress(w.step_count());
             Ok(())
-        }) {
+        });
+        if let Err(err) = reached {
             if looking {
                 done = true;
                 return Ok(Flow::Stop);
             }
             report.mismatch = Some(Mismatch {
                 step: replay.step_count(),
-                what: format!("{err:#}, but the recording goes on to step {step}"),
+                what: format!(
+                    "{}, but the recording goes on to step {step}",
+                    with_causes(&err)
+                ),
                 critter: None,
             });
             done = true;
@@ -137,10 +147,7 @@ pub fn verify(rec: &Recording, mut progress: impl FnMut(u64)) -> anyhow::Result<
             }
             schema::STATE => {
                 report.states += 1;
-                let recorded: StateMsg = decode(topic, data)?;
-                recorded
-                    .check()
-                    .map_err(|e| anyhow::anyhow!("the state of step {step}: {e}"))?;
+                let recorded = decode_state(data)?;
                 let mine = capture::any_state(world);
                 let diff = first_difference(&recorded, &mine, "recorded", "replayed");
                 if let Some(m) = &mut report.mismatch {

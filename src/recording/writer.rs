@@ -8,6 +8,7 @@
 //! whose complete chunks `critterbox recover` reads back.
 
 use super::capture::{self, KindTable, StepRecord};
+use super::error::RecordingError;
 use super::foxglove;
 use super::meta::{EndMeta, RunMeta};
 use super::schema::{self, ErrorMsg, Float, HashMsg, StateMsg};
@@ -35,19 +36,6 @@ const BATCH: usize = 16;
 
 /// zstd level of the chunks (see docs/recording-format.md for the measurements).
 const ZSTD_LEVEL: u32 = 1;
-
-/// What went wrong while recording.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordError {
-    /// The file could not be created or written.
-    #[error("cannot write the recording {path}: {message}")]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
-}
 
 enum Job {
     Steps(Vec<StepRecord>),
@@ -98,8 +86,8 @@ fn yield_to_the_simulation() {
     }
 }
 
-fn write_err(path: &Path, e: impl std::fmt::Display) -> RecordError {
-    RecordError::Write {
+fn write_err(path: &Path, e: impl std::fmt::Display) -> RecordingError {
+    RecordingError::CannotWrite {
         path: path.to_path_buf(),
         message: e.to_string(),
     }
@@ -113,7 +101,7 @@ impl Recorder {
         meta: &RunMeta,
         sources: &[SourceFile],
         world: &AnyWorld,
-    ) -> Result<Recorder, RecordError> {
+    ) -> Result<Recorder, RecordingError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| write_err(path, e))?;
         }
@@ -194,12 +182,12 @@ impl Recorder {
     }
 
     /// Records the step just taken: hash, totals and events, and the full state on keyframes.
-    pub fn record(&mut self, world: &AnyWorld) -> Result<(), RecordError> {
+    pub fn record(&mut self, world: &AnyWorld) -> Result<(), RecordingError> {
         let full = world.step_count().is_multiple_of(self.every);
         self.capture(world, full)
     }
 
-    fn capture(&mut self, world: &AnyWorld, full: bool) -> Result<(), RecordError> {
+    fn capture(&mut self, world: &AnyWorld, full: bool) -> Result<(), RecordingError> {
         let rec = capture::capture(world, full, self.known_kinds);
         if let Some(k) = &rec.kinds {
             self.known_kinds = k.names.len();
@@ -215,7 +203,7 @@ impl Recorder {
         Ok(())
     }
 
-    fn send_batch(&mut self) -> Result<(), RecordError> {
+    fn send_batch(&mut self) -> Result<(), RecordingError> {
         if self.batch.is_empty() {
             return Ok(());
         }
@@ -224,12 +212,12 @@ impl Recorder {
     }
 
     /// Sends `job` after the steps still batched.
-    fn send(&mut self, job: Job) -> Result<(), RecordError> {
+    fn send(&mut self, job: Job) -> Result<(), RecordingError> {
         self.send_batch()?;
         self.send_now(job)
     }
 
-    fn send_now(&mut self, job: Job) -> Result<(), RecordError> {
+    fn send_now(&mut self, job: Job) -> Result<(), RecordingError> {
         let sent = match &self.tx {
             Some(tx) => tx.send(job).is_ok(),
             None => false,
@@ -248,7 +236,7 @@ impl Recorder {
     }
 
     /// Records the error that stopped the run, in the step after the last one recorded.
-    pub fn record_error(&mut self, world: &AnyWorld, message: &str) -> Result<(), RecordError> {
+    pub fn record_error(&mut self, world: &AnyWorld, message: &str) -> Result<(), RecordingError> {
         self.send(Job::Error(ErrorMsg {
             step: self.last_step + 1,
             time: Float(world.time()),
@@ -257,7 +245,7 @@ impl Recorder {
     }
 
     /// Attaches more script files (kinds loaded after the scene was set up).
-    pub fn attach(&mut self, sources: Vec<SourceFile>) -> Result<(), RecordError> {
+    pub fn attach(&mut self, sources: Vec<SourceFile>) -> Result<(), RecordingError> {
         if sources.is_empty() {
             return Ok(());
         }
@@ -266,7 +254,7 @@ impl Recorder {
 
     /// Writes the final full state (if the last step was not a keyframe), the end record and the
     /// summary, and closes the file.
-    pub fn finish(mut self, world: &AnyWorld, end: EndMeta) -> Result<Written, RecordError> {
+    pub fn finish(mut self, world: &AnyWorld, end: EndMeta) -> Result<Written, RecordingError> {
         if world.step_count() == self.last_step && self.last_state != self.last_step {
             let state = capture::any_state(world);
             self.send(Job::State(Box::new(state)))?;
@@ -274,7 +262,7 @@ impl Recorder {
         self.close(end)
     }
 
-    fn close(&mut self, end: EndMeta) -> Result<Written, RecordError> {
+    fn close(&mut self, end: EndMeta) -> Result<Written, RecordingError> {
         self.send(Job::Finish(end))?;
         self.tx = None;
         match self.thread.take().map(JoinHandle::join) {
@@ -340,7 +328,7 @@ impl Output {
                 })),
             };
             match job {
-                Some(Job::Finish(end)) => return self.close(&end).map_err(|e| e.to_string()),
+                Some(Job::Finish(end)) => return self.close(&end),
                 Some(job) => {
                     self.write(job).map_err(|e| e.to_string())?;
                     dirty = true;
@@ -356,14 +344,16 @@ impl Output {
     }
 
     /// Writes the end record and the summary, and flushes the file.
-    fn close(mut self, end: &EndMeta) -> anyhow::Result<(u64, u64)> {
-        self.w.write_metadata(&Metadata {
-            name: schema::END.into(),
-            metadata: end.to_map(),
-        })?;
-        self.w.finish()?;
+    fn close(mut self, end: &EndMeta) -> Result<(u64, u64), String> {
+        self.w
+            .write_metadata(&Metadata {
+                name: schema::END.into(),
+                metadata: end.to_map(),
+            })
+            .map_err(|e| e.to_string())?;
+        self.w.finish().map_err(|e| e.to_string())?;
         let mut file = self.w.into_inner();
-        std::io::Write::flush(&mut file)?;
+        std::io::Write::flush(&mut file).map_err(|e| e.to_string())?;
         Ok((self.steps, self.states))
     }
 
