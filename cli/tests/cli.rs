@@ -76,10 +76,12 @@ fn every_scene_runs_from_the_command_line() {
     for s in critterbox::scenes::SCENES {
         let o = critterbox(&["run", s.name, "--steps", "20", "--stats"]);
         assert!(o.status.success(), "{}: {}", s.name, stderr(&o));
-        assert!(
-            stdout(&o).contains("broad phase"),
-            "--stats prints stage times"
-        );
+        for stage in ["update", "move", "pairs", "response", "lifecycle", "total"] {
+            assert!(
+                stdout(&o).contains(&format!("  {stage:<12} ")),
+                "--stats prints the time of the {stage} stage"
+            );
+        }
         // Runs record by default, so the recording's own time is there too.
         assert!(
             stdout(&o).contains("  record       "),
