@@ -40,6 +40,7 @@ pub mod rules;
 pub mod scenes;
 pub mod script;
 pub mod stability;
+pub mod testing;
 
 pub mod vector;
 #[cfg(feature = "rerun")]
