@@ -41,6 +41,7 @@ pub mod rng;
 pub mod rules;
 pub mod scenes;
 pub mod script;
+pub mod testing;
 pub mod vector;
 #[cfg(feature = "rerun")]
 pub mod viewer;

@@ -1,7 +1,7 @@
 //! Runs every script test (`fn test_*()` in scripts/tests/*.rhai) as its own cargo test, so
 //! `cargo test` and `cargo nextest run` cover the rules written in rhai by name.
 
-use critterbox::script::testing::{discover, find_test_files, run_one, TestOptions};
+use critterbox::testing::{discover, find_test_files, run_one, TestOptions};
 use libtest_mimic::{Arguments, Failed, Trial};
 use std::path::PathBuf;
 

@@ -1,177 +1,33 @@
 //! The bridge between running scripts and the world they act on.
 //!
 //! A script function registered with the engine cannot hold a borrow of the world: the world
-//! calls the script (from a hook, inside `World::step`), and the script calls back into the world.
-//! So while a script runs, the [`Host`] holds a raw pointer to what the script may touch: the
-//! whole [`World`] (scene setup, `on_step`) or a hook's [`Access`] (inside a step). The pointer is
-//! set by [`Host::enter`] for exactly the duration of one call into the script and restored by a
-//! guard, so it never outlives the borrow it came from; script functions reach it through
-//! [`with_env!`], one short-lived `&mut` at a time.
+//! calls the script (from a hook, inside `World::step`), and the script calls back into the
+//! world. So the [`Host`] knows what running scripts may touch, its *target*:
+//!
+//! - its own scene (a scene's setup, a test's world), which it owns in a `RefCell` and lends
+//!   anew to each script function that touches it, and to each [`Host::with_scene`];
+//! - or what [`Host::enter`] lends for one call into a script: a hook's `Access` inside a step,
+//!   or a scene's world during `on_step`, as a pointer whose lifetime is erased and which a
+//!   guard takes back before the borrow it came from ends.
+//!
+//! Script functions reach the target through [`with_env!`], one short-lived `&mut dyn Env` at a
+//! time: while one lives, the target is marked busy, so a second is never derived beside it.
+//! Every pointer into the world is derived from one place (the host's scene, or the `&mut` lent
+//! to `enter`) at the moment of use and dropped after it; none is kept across another `&mut`.
 
-use crate::border::Topology;
-use crate::context::Access;
-use crate::critter::{Critter, CritterId, CritterSpec};
-use crate::error::Error;
-use crate::kind::{KindId, KindSet};
-use crate::rng::Rng;
+use super::api::{error, no_world, Res};
+use super::env::Env;
+use super::{Extension, Runtime};
+use crate::error::ScriptError;
+use crate::scenes::{AnyWorld, Scene};
 use crate::vector::Vector;
-use crate::world::World;
 use glam::{DVec2, DVec3};
-use std::cell::{Cell, RefCell};
+use std::cell::{Cell, RefCell, RefMut};
+use std::rc::{Rc, Weak};
 
-/// What a script may do to the world it runs in.
-pub(crate) trait Env<V: Vector> {
-    fn critter(&self, id: CritterId) -> Option<&Critter<V>>;
-    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>>;
-    fn kinds(&self) -> &KindSet<V>;
-    fn topology(&self) -> &Topology<V>;
-    fn step_count(&self) -> u64;
-    fn time(&self) -> f64;
-    fn dt(&self) -> f64;
-    fn rng(&mut self) -> &mut Rng;
-    fn die(&mut self, id: CritterId);
-    fn damage(&mut self, id: CritterId, amount: f64);
-    /// Spawns now (`Some(id)`) between steps, or queues for the end of the step (`None`).
-    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error>;
-    fn log(&mut self, line: String);
-    fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
-    fn touches(&self, a: CritterId, b: CritterId) -> bool {
-        match (self.critter(a), self.critter(b)) {
-            (Some(x), Some(y)) => crate::response::touches(self.topology(), x, y),
-            _ => false,
-        }
-    }
-    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
-        match (self.critter(outer), self.critter(inner)) {
-            (Some(o), Some(i)) => crate::response::contains(self.topology(), o, i),
-            _ => false,
-        }
-    }
-    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
-        let (x, y) = (self.critter(a)?, self.critter(b)?);
-        Some(self.topology().delta(x.pos, y.pos).length())
-    }
-    /// The default response; `Err` outside a step.
-    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
-    /// The world itself, between steps (scene setup and `on_step`).
-    fn world(&mut self) -> Option<&mut World<V>>;
-}
-
-impl<V: Vector> Env<V> for World<V> {
-    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
-        self.get(id)
-    }
-    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
-        self.get_mut(id)
-    }
-    fn kinds(&self) -> &KindSet<V> {
-        World::kinds(self)
-    }
-    fn topology(&self) -> &Topology<V> {
-        World::topology(self)
-    }
-    fn step_count(&self) -> u64 {
-        World::step_count(self)
-    }
-    fn time(&self) -> f64 {
-        World::time(self)
-    }
-    fn dt(&self) -> f64 {
-        World::dt(self)
-    }
-    fn rng(&mut self) -> &mut Rng {
-        World::rng(self)
-    }
-    fn die(&mut self, id: CritterId) {
-        // Between steps a death takes effect at once.
-        let _ = self.remove(id);
-    }
-    fn damage(&mut self, id: CritterId, amount: f64) {
-        let dead = match self.get_mut(id) {
-            Some(c) => {
-                c.traits_mut().health -= amount;
-                c.health() <= 0.0
-            }
-            None => false,
-        };
-        if dead {
-            let _ = self.remove(id);
-        }
-    }
-    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
-        World::spawn(self, spec).map(Some)
-    }
-    fn log(&mut self, line: String) {
-        self.log_line(line);
-    }
-    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
-        self.critters()
-            .iter()
-            .filter(|c| c.is_alive() && World::kinds(self).is_kind(c.kind(), kind))
-            .map(|c| c.id())
-            .collect()
-    }
-    fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
-        Err("collide_default can only be called inside a collide hook".into())
-    }
-    fn world(&mut self) -> Option<&mut World<V>> {
-        Some(self)
-    }
-}
-
-impl<V: Vector> Env<V> for Access<'_, V> {
-    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
-        self.get(id)
-    }
-    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
-        self.get_mut(id)
-    }
-    fn kinds(&self) -> &KindSet<V> {
-        Access::kinds(self)
-    }
-    fn topology(&self) -> &Topology<V> {
-        Access::topology(self)
-    }
-    fn step_count(&self) -> u64 {
-        self.step()
-    }
-    fn time(&self) -> f64 {
-        Access::time(self)
-    }
-    fn dt(&self) -> f64 {
-        Access::dt(self)
-    }
-    fn rng(&mut self) -> &mut Rng {
-        Access::rng(self)
-    }
-    fn die(&mut self, id: CritterId) {
-        Access::die(self, id)
-    }
-    fn damage(&mut self, id: CritterId, amount: f64) {
-        Access::damage(self, id, amount)
-    }
-    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
-        Access::spawn(self, spec);
-        Ok(None)
-    }
-    fn log(&mut self, line: String) {
-        Access::log(self, line)
-    }
-    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
-        Access::critters_of(self, kind)
-    }
-    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String> {
-        Ok(self.collide_default_pair(caller, arg).is_some())
-    }
-    fn world(&mut self) -> Option<&mut World<V>> {
-        None
-    }
-}
-
-/// The current environment of a running script, if any.
+/// An environment lent by [`Host::enter`], its lifetime erased.
 #[derive(Clone, Copy)]
 pub(crate) enum EnvPtr {
-    None,
     D2(*mut (dyn Env<DVec2> + 'static)),
     D3(*mut (dyn Env<DVec3> + 'static)),
 }
@@ -193,9 +49,45 @@ impl Dim for DVec3 {
     }
 }
 
+/// The pointer of `env`, its lifetime erased; see [`Host::enter`] and [`Host::access`] for how
+/// long it is used.
+fn erase<V: Dim>(env: &mut (dyn Env<V> + '_)) -> EnvPtr {
+    let short: *mut (dyn Env<V> + '_) = env;
+    // SAFETY: only the trait object's lifetime bound changes, not the pointer or its vtable.
+    // The two callers dereference the result only while the borrow it came from is live.
+    let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
+    V::env_ptr(erased)
+}
+
+/// What running scripts act on.
+#[derive(Clone, Copy)]
+enum Target {
+    /// The host's scene (scripts fail with "no world yet" while it has none).
+    Scene,
+    /// What [`Host::enter`] lent for the current call.
+    Entered(EnvPtr),
+    /// No world: a kind file's top level.
+    Nothing,
+    /// In use by a script function (see [`Host::access`]).
+    Busy,
+}
+
+/// Why [`Host::with_scene`] could not lend the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum NoScene {
+    /// No script has made or loaded one.
+    Missing,
+    /// It is lent already: the caller runs inside its step (a kind's hook).
+    Busy,
+}
+
 /// Shared state of one script runtime: where running scripts act, and per-step counters.
 pub(crate) struct Host {
-    env: Cell<EnvPtr>,
+    target: Cell<Target>,
+    /// The scene a script made or loaded, owned here until [`Host::take_scene`].
+    scene: RefCell<Option<Scene>>,
+    /// What the layer that made the runtime added to it (the test runner's API).
+    pub extension: Option<Rc<dyn Extension>>,
     /// Spawns requested by scripts in the current step.
     pub spawns: Cell<u64>,
     /// The step `spawns` counts for.
@@ -203,22 +95,9 @@ pub(crate) struct Host {
     /// Most spawns scripts may request in one step.
     pub max_spawns_per_step: u64,
     /// The runtime this host belongs to (for loading kinds from scripts).
-    pub runtime: super::RuntimeLink,
+    runtime: Weak<Runtime>,
     /// While a kind file's top level runs: what it declares.
     pub kind_decl: RefCell<Option<super::kind::KindDecl>>,
-    /// The scene a script is building or a test is running (owned here while it runs; taken
-    /// back with `Box::from_raw` by whoever finishes the run).
-    pub scene_world: Cell<*mut crate::scenes::Scene>,
-    /// True while test scripts run: they may load scenes and step worlds.
-    pub testing: Cell<bool>,
-    /// A test's wall-clock deadline.
-    pub deadline: Cell<Option<std::time::Instant>>,
-    /// The recording of a test's run (kept only if the test fails).
-    pub test_recorder: RefCell<Option<crate::recording::Recorder>>,
-    /// Where a test's run would be recorded, and the test's name; `None` records nothing.
-    pub test_record_path: RefCell<Option<(std::path::PathBuf, String)>>,
-    /// `critterbox test --bless`: golden recordings are rewritten, not compared.
-    pub bless: Cell<bool>,
     /// Set by `world.stop(reason)`.
     pub stop: RefCell<Option<String>>,
     /// Steps the scene asked for (`world(#{ steps: ... })`).
@@ -227,24 +106,36 @@ pub(crate) struct Host {
     pub seed_override: Cell<Option<u64>>,
     /// A located error from deeper down (a kind file a scene loaded, a hook run by a spawn),
     /// kept whole while rhai carries its text up through the calling script.
-    pub stashed: RefCell<Option<Box<crate::error::ScriptError>>>,
+    pub stashed: RefCell<Option<Box<ScriptError>>>,
+}
+
+/// Puts a host's previous target back when dropped, also when a script call unwinds.
+struct Restore<'h> {
+    target: &'h Cell<Target>,
+    previous: Target,
+}
+
+impl Drop for Restore<'_> {
+    fn drop(&mut self) {
+        self.target.set(self.previous);
+    }
 }
 
 impl Host {
-    pub fn new(max_spawns_per_step: u64) -> Self {
+    pub fn new(
+        max_spawns_per_step: u64,
+        extension: Option<Rc<dyn Extension>>,
+        runtime: Weak<Runtime>,
+    ) -> Self {
         Host {
-            env: Cell::new(EnvPtr::None),
+            target: Cell::new(Target::Scene),
+            scene: RefCell::new(None),
+            extension,
             spawns: Cell::new(0),
             spawns_step: Cell::new(u64::MAX),
             max_spawns_per_step,
-            runtime: RefCell::new(std::rc::Weak::new()),
+            runtime,
             kind_decl: RefCell::new(None),
-            scene_world: Cell::new(std::ptr::null_mut()),
-            testing: Cell::new(false),
-            deadline: Cell::new(None),
-            test_recorder: RefCell::new(None),
-            test_record_path: RefCell::new(None),
-            bless: Cell::new(false),
             stop: RefCell::new(None),
             scene_steps: Cell::new(None),
             seed_override: Cell::new(None),
@@ -252,43 +143,92 @@ impl Host {
         }
     }
 
+    /// The runtime this host belongs to.
+    pub fn runtime(&self) -> Res<Rc<Runtime>> {
+        self.runtime
+            .upgrade()
+            .ok_or_else(|| error("the script runtime is gone"))
+    }
+
+    /// Points scripts at `target` until the guard drops.
+    fn aim(&self, target: Target) -> Restore<'_> {
+        Restore {
+            target: &self.target,
+            previous: self.target.replace(target),
+        }
+    }
+
     /// Runs `f` with no world reachable from scripts (kind files' top level).
     pub fn without_env<R>(&self, f: impl FnOnce() -> R) -> R {
-        struct Restore<'h>(&'h Cell<EnvPtr>, EnvPtr);
-        impl Drop for Restore<'_> {
-            fn drop(&mut self) {
-                self.0.set(self.1);
-            }
-        }
-        let _restore = Restore(&self.env, self.env.replace(EnvPtr::None));
+        let _restore = self.aim(Target::Nothing);
         f()
     }
 
-    /// Points scripts at `ptr` until [`Host::clear_env`] (a scene's top level, which spans many
-    /// calls). The caller keeps the pointee alive and otherwise untouched until then.
-    pub fn set_env(&self, ptr: EnvPtr) {
-        self.env.set(ptr);
+    /// Runs `f` with scripts acting on `env`; the previous target is restored afterwards, also
+    /// when `f` unwinds.
+    pub fn enter<V: Dim, R>(&self, env: &mut dyn Env<V>, f: impl FnOnce() -> R) -> R {
+        // The pointer lives in the target only while `f` runs: `_restore` removes it before
+        // `env`'s borrow ends, and nothing else uses `env` meanwhile (it is lent to this call).
+        let _restore = self.aim(Target::Entered(erase(env)));
+        f()
     }
 
-    /// Takes back the scene a script made or loaded, and points scripts at nothing.
-    pub fn take_scene(&self) -> Option<crate::scenes::Scene> {
-        self.clear_env();
-        let raw = self.scene_world.replace(std::ptr::null_mut());
-        // SAFETY: `raw` came from `Box::into_raw` when the scene was stored, and the environment
-        // pointing into it has just been cleared.
-        (!raw.is_null()).then(|| *unsafe { Box::from_raw(raw) })
+    /// True when the host holds a scene (lent out or not).
+    pub fn has_scene(&self) -> bool {
+        self.scene.try_borrow().map_or(true, |s| s.is_some())
     }
 
-    /// Stores `scene` as the one scripts act on, and points them at its world.
-    pub fn put_scene(&self, scene: crate::scenes::Scene) {
-        let raw = Box::into_raw(Box::new(scene));
-        self.scene_world.set(raw);
-        // SAFETY: `raw` stays alive until `take_scene`.
-        let ptr = match unsafe { &mut (*raw).world } {
-            crate::scenes::AnyWorld::D2(w) => env_of::<DVec2>(w),
-            crate::scenes::AnyWorld::D3(w) => env_of::<DVec3>(w),
+    /// Stores `scene` as the one scripts act on, and tells the extension, if any.
+    pub fn put_scene(&self, scene: Scene) -> Res<()> {
+        *self.scene.try_borrow_mut().map_err(|_| busy())? = Some(scene);
+        match &self.extension {
+            Some(extension) => extension.scene_made(self),
+            None => Ok(()),
+        }
+    }
+
+    /// Takes back the scene a script made or loaded.
+    pub fn take_scene(&self) -> Option<Scene> {
+        // Called once the scripts are done, so nothing holds the scene.
+        self.scene.try_borrow_mut().ok().and_then(|mut s| s.take())
+    }
+
+    /// Runs `f` on the host's scene (a test stepping its world).
+    pub fn with_scene<R>(&self, f: impl FnOnce(&mut Scene) -> R) -> Result<R, NoScene> {
+        let mut slot = self.scene.try_borrow_mut().map_err(|_| NoScene::Busy)?;
+        let scene = slot.as_mut().ok_or(NoScene::Missing)?;
+        Ok(f(scene))
+    }
+
+    /// What one script function acts on, until the returned access drops; meanwhile the target
+    /// is busy. Used through [`with_env!`].
+    ///
+    /// # Safety
+    /// The access must be dropped before the script function that asked for it returns: a
+    /// target lent by [`Host::enter`] is valid only until `enter` returns.
+    #[inline]
+    pub unsafe fn access(&self) -> Res<EnvAccess<'_>> {
+        let (ptr, scene) = match self.target.get() {
+            Target::Entered(ptr) => (ptr, None),
+            Target::Scene => {
+                let mut slot = self.scene.try_borrow_mut().map_err(|_| busy())?;
+                let Some(scene) = slot.as_mut() else {
+                    return Err(no_world());
+                };
+                let ptr = match &mut scene.world {
+                    AnyWorld::D2(w) => erase::<DVec2>(w),
+                    AnyWorld::D3(w) => erase::<DVec3>(w),
+                };
+                (ptr, Some(slot))
+            }
+            Target::Nothing => return Err(no_world()),
+            Target::Busy => return Err(busy()),
         };
-        self.set_env(ptr);
+        Ok(EnvAccess {
+            ptr,
+            _scene: scene,
+            _restore: self.aim(Target::Busy),
+        })
     }
 
     /// The error as rhai should carry it; a located script error is also kept whole, so
@@ -302,18 +242,15 @@ impl Host {
             }
             other => other.to_string(),
         };
-        Box::new(rhai::EvalAltResult::ErrorRuntime(
-            rhai::Dynamic::from(text),
-            rhai::Position::NONE,
-        ))
+        error(text)
     }
 
     /// The kept error if `e` is the one it carried up, else `fallback()`.
     pub fn locate(
         &self,
         e: &rhai::EvalAltResult,
-        fallback: impl FnOnce() -> crate::error::ScriptError,
-    ) -> crate::error::ScriptError {
+        fallback: impl FnOnce() -> ScriptError,
+    ) -> ScriptError {
         let kept = self.stashed.borrow_mut().take();
         match (kept, e.unwrap_inner()) {
             (Some(s), rhai::EvalAltResult::ErrorRuntime(v, _))
@@ -324,63 +261,62 @@ impl Host {
             _ => fallback(),
         }
     }
+}
 
-    /// Ends [`Host::set_env`].
-    pub fn clear_env(&self) {
-        self.env.set(EnvPtr::None);
-    }
+/// The error of a script function that reaches for the world while another holds it.
+fn busy() -> Box<rhai::EvalAltResult> {
+    error("the world is busy: a script reached for it from inside a call that is using it")
+}
 
-    /// Runs `f` with scripts acting on `env`; the previous environment is restored afterwards,
-    /// also when `f` unwinds.
-    pub fn enter<V: Dim, R>(&self, env: &mut dyn Env<V>, f: impl FnOnce() -> R) -> R {
-        struct Restore<'h>(&'h Cell<EnvPtr>, EnvPtr);
-        impl Drop for Restore<'_> {
-            fn drop(&mut self) {
-                self.0.set(self.1);
-            }
+/// One script function's hold on its target, from [`Host::access`].
+pub(crate) struct EnvAccess<'h> {
+    ptr: EnvPtr,
+    /// The host's scene, held while `ptr` points into it.
+    _scene: Option<RefMut<'h, Option<Scene>>>,
+    /// Marks the target busy until this access drops.
+    _restore: Restore<'h>,
+}
+
+/// The environment of one script function, in the running world's dimension.
+pub(crate) enum EnvRef<'a> {
+    D2(&'a mut dyn Env<DVec2>),
+    D3(&'a mut dyn Env<DVec3>),
+}
+
+impl EnvAccess<'_> {
+    #[inline]
+    pub fn env(&mut self) -> EnvRef<'_> {
+        // SAFETY: `ptr` is valid and not otherwise used while this access lives. Either it was
+        // derived in `Host::access` from the scene held in `_scene`, or it was lent by
+        // `Host::enter`, whose caller does not touch the pointee until `enter` returns, and this
+        // access lives inside one script function, inside that call (`Host::access`'s contract).
+        // The target is busy meanwhile, so no second reference is derived from `ptr`; a script
+        // run from here (a spawn's `init`) is lent a pointer derived from the reference returned
+        // here, through its own `enter`, so the two nest as reborrows do.
+        match self.ptr {
+            EnvPtr::D2(p) => EnvRef::D2(unsafe { &mut *p }),
+            EnvPtr::D3(p) => EnvRef::D3(unsafe { &mut *p }),
         }
-        let short: *mut (dyn Env<V> + '_) = env;
-        // SAFETY: only the lifetime bound is erased. The pointer is stored for the duration of
-        // `f` and removed by `Restore` before `env`'s borrow ends; it is dereferenced only inside
-        // `f` (by script functions called from it), never concurrently with another use of `env`.
-        let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
-        let _restore = Restore(&self.env, self.env.replace(V::env_ptr(erased)));
-        f()
-    }
-
-    /// The current environment.
-    pub fn current(&self) -> EnvPtr {
-        self.env.get()
     }
 }
 
-/// Runs `$body` with `$env` bound to the current environment as `&mut dyn Env<V>`, for whichever
-/// dimension the running world has. Evaluates to an error when no world is active.
+/// Runs `$body` with `$env` bound to the running script's environment as `&mut dyn Env<V>`,
+/// for whichever dimension the world has (the body is compiled once for each). Evaluates to an
+/// error when no world is reachable.
 macro_rules! with_env {
-    ($host:expr, $env:ident => $body:expr) => {
-        match $host.current() {
-            $crate::script::host::EnvPtr::None => Err($crate::script::api::no_world()),
-            $crate::script::host::EnvPtr::D2(p) => {
-                // SAFETY: see `Host::enter`: the pointer is live while a script runs.
-                #[allow(unused_unsafe)]
-                let $env = unsafe { &mut *p };
-                $body
-            }
-            $crate::script::host::EnvPtr::D3(p) => {
-                // SAFETY: as above.
-                #[allow(unused_unsafe)]
-                let $env = unsafe { &mut *p };
-                $body
-            }
+    ($host:expr, $env:ident => $body:expr) => {{
+        let host: &$crate::script::host::Host = &$host;
+        // SAFETY: the access is dropped at the end of this match, inside the script function.
+        match unsafe { host.access() } {
+            Err(e) => Err(e),
+            Ok(mut access) => match access.env() {
+                $crate::script::host::EnvRef::D2($env) => $body,
+                $crate::script::host::EnvRef::D3($env) => $body,
+            },
         }
-    };
+    }};
 }
 pub(crate) use with_env;
 
-/// The environment pointer of a world (lifetime erased; see [`Host::enter`]).
-pub(crate) fn env_of<V: Dim>(w: &mut World<V>) -> EnvPtr {
-    let short: *mut (dyn Env<V> + '_) = w;
-    // SAFETY: lifetime erasure only; callers keep `w` alive while the pointer is in use.
-    let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
-    V::env_ptr(erased)
-}
+#[cfg(test)]
+mod tests;

@@ -6,9 +6,10 @@
 //! any of `init(me)`, `update(me, dt)`, `collides_with(me, other)`, `collide(me, other)`. Hooks it
 //! does not define are inherited from its parent kind, and from the engine beyond that.
 
-use super::api::{num_or, props_from_map, rule_code, rule_of_code, CritterRef, Res};
+use super::api::{error, fail, num_or, props_from_map, rule_code, rule_of_code, CritterRef, Res};
+use super::env::Env;
 use super::errors::{eval_error, fn_location};
-use super::host::{Dim, Env};
+use super::host::Dim;
 use super::{read_script, Runtime, SourceFile};
 use crate::border::Topology;
 use crate::context::{CollideCtx, UpdateCtx};
@@ -132,8 +133,17 @@ pub(crate) fn load_def(rt: &Runtime, name_or_path: &str) -> Result<Rc<ScriptKind
     if let Some(def) = rt.kinds.borrow().get(&name) {
         return Ok(def.clone());
     }
-    let file = path.display().to_string();
     let text = read_script(&path)?;
+    define(rt, path.display().to_string(), name, text)
+}
+
+/// Defines the kind `name` from `text`, the text of its file `file`, and loads its parents.
+pub(crate) fn define(
+    rt: &Runtime,
+    file: String,
+    name: String,
+    text: String,
+) -> Result<Rc<ScriptKindDef>, Error> {
     let ast = rt
         .compile(&file, &text)
         .map_err(|e| in_kind(e, &file, &name))?;
@@ -271,23 +281,22 @@ fn apply_defaults(d: &mut KindDefaults, depends: &mut bool, map: &Map) -> Res<()
             "restitution" => d.restitution = n("restitution")?,
             "health" => d.health = n("health")?,
             "fixed" => {
-                d.fixed = value.as_bool().map_err(|_| {
-                    super::api::fail::<()>("fixed must be true or false").unwrap_err()
-                })?
+                d.fixed = value
+                    .as_bool()
+                    .map_err(|_| error("fixed must be true or false"))?
             }
             "rule_depends_on_state" => {
-                *depends = value.as_bool().map_err(|_| {
-                    super::api::fail::<()>("rule_depends_on_state must be true or false")
-                        .unwrap_err()
-                })?
+                *depends = value
+                    .as_bool()
+                    .map_err(|_| error("rule_depends_on_state must be true or false"))?
             }
             "color" => d.color = Some(value.to_string()),
             "props" => match value.clone().try_cast::<Map>() {
                 Some(props) => d.props.extend(props_from_map(&props)?),
-                None => return super::api::fail("props must be a map, e.g. props: #{ damage: 1 }"),
+                None => return fail("props must be a map, e.g. props: #{ damage: 1 }"),
             },
             other => {
-                return super::api::fail(format!(
+                return fail(format!(
                     "unknown default '{other}'; a kind's defaults are {}",
                     DEFAULT_KEYS.join(", ")
                 ))

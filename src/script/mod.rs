@@ -2,27 +2,29 @@
 //! (`scripts/kinds/*.rhai`) that give critters their own `collide`, `collides_with`, `update` and
 //! `init`. The user's guide is `docs/scripting.md`.
 //!
-//! One [`Runtime`] per run holds the engine (built once by [`api::build_engine`]), each kind's
-//! compiled AST, and the [`host::Host`] through which running scripts reach the world. Each hook is
-//! a plain `call_fn` on an AST compiled once, with the top level not re-run and no per-call scope
-//! allocation; a kind's hooks run only for pairs that really touch, and only for kinds that
-//! define them.
+//! One `Runtime` per run holds the engine (built once by `api::build_engine`), each kind's
+//! compiled AST, and the `Host` (`host.rs`) through which running scripts reach the world. Each
+//! hook is a plain `call_fn` on an AST compiled once, with the top level not re-run and no
+//! per-call scope allocation; a kind's hooks run only for pairs that really touch, and only for
+//! kinds that define them. A layer above (the script test runner, [`crate::testing`]) adds its
+//! functions through an `Extension`; nothing here depends on it or on recordings.
 
 pub(crate) mod api;
+pub(crate) mod env;
 pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
 pub(crate) mod scene;
-pub mod testing;
 
 use crate::error::{Error, ScriptError};
-use crate::scenes::Scene;
+use crate::scenes::{Scene, SourceFile};
+use api::Res;
 use host::Host;
 use rhai::{Engine, AST};
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::rc::{Rc, Weak};
+use std::rc::Rc;
 
 /// Limits on what one script call may do. The defaults are far above what real scripts need.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,8 +56,6 @@ impl Default for Limits {
     }
 }
 
-pub use crate::scenes::SourceFile;
-
 /// Where scripts live and how they are limited.
 #[derive(Clone, Debug, Default)]
 pub struct ScriptOptions {
@@ -81,11 +81,27 @@ pub(crate) struct Runtime {
     pub limits: Limits,
 }
 
+/// What a layer above scripts adds to a runtime (the script test runner's API): functions on
+/// its engine, and a word each time a script puts a scene into the runtime's host.
+pub(crate) trait Extension {
+    /// Registers the functions; they reach the world through `host`.
+    fn register(self: Rc<Self>, engine: &mut Engine, host: &Rc<Host>);
+    /// A script has just made the host's scene (`world(#{ ... })`) or loaded one.
+    fn scene_made(&self, host: &Host) -> Res<()>;
+}
+
 impl Runtime {
+    /// A runtime for scripts in `scene_dir` (kinds are looked up beside it).
     pub fn new(options: &ScriptOptions, scene_dir: Option<&Path>) -> Rc<Runtime> {
-        let host = Rc::new(Host::new(options.limits.max_spawns_per_step));
-        host.seed_override.set(options.seed);
-        let engine = api::build_engine(&host, &options.limits);
+        Runtime::extended(options, scene_dir, None)
+    }
+
+    /// A runtime whose engine also has `extension`'s functions.
+    pub fn extended(
+        options: &ScriptOptions,
+        scene_dir: Option<&Path>,
+        extension: Option<Rc<dyn Extension>>,
+    ) -> Rc<Runtime> {
         let mut kind_dirs = options.kind_dirs.clone();
         if let Some(dir) = scene_dir {
             kind_dirs.push(dir.join("../kinds"));
@@ -93,16 +109,22 @@ impl Runtime {
             kind_dirs.push(dir.to_path_buf());
         }
         kind_dirs.push(PathBuf::from("scripts/kinds"));
-        let rt = Rc::new(Runtime {
-            engine,
-            host,
-            kind_dirs,
-            kinds: RefCell::new(BTreeMap::new()),
-            sources: RefCell::new(Vec::new()),
-            limits: options.limits.clone(),
-        });
-        *rt.host.runtime.borrow_mut() = Rc::downgrade(&rt);
-        rt
+        Rc::new_cyclic(|runtime| {
+            let host = Rc::new(Host::new(
+                options.limits.max_spawns_per_step,
+                extension,
+                runtime.clone(),
+            ));
+            host.seed_override.set(options.seed);
+            Runtime {
+                engine: api::build_engine(&host, &options.limits),
+                host,
+                kind_dirs,
+                kinds: RefCell::new(BTreeMap::new()),
+                sources: RefCell::new(Vec::new()),
+                limits: options.limits.clone(),
+            }
+        })
     }
 
     /// Compiles `text` as `path`; errors carry file, line and column.
@@ -201,6 +223,3 @@ pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, 
     }
     Ok(report)
 }
-
-/// The weak link from the host back to its runtime.
-pub(crate) type RuntimeLink = RefCell<Weak<Runtime>>;

@@ -2,10 +2,10 @@
 
 use anyhow::Context;
 use clap::Args;
-use critterbox::script::testing::{
+use critterbox::script::{Limits, ScriptOptions};
+use critterbox::testing::{
     discover, find_test_files, junit_xml, run_tests, TestOptions, TestOutcome,
 };
-use critterbox::script::{Limits, ScriptOptions};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;

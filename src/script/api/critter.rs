@@ -1,0 +1,297 @@
+//! `Critter`: a handle to a critter. Reading or writing its fields (`c.pos`, `c.vel = ...`) and
+//! user properties (`c["score"]`, `c.score`) goes to the world; it also answers questions about
+//! pairs (`touches`, `contains`, `distance`) and acts (`damage`, `die`, `collide_default`).
+
+use super::values::{from_prop, from_svec, num_or, to_prop, to_svec};
+use super::{error, fail, fail_hint, lib_err, Res};
+use crate::critter::CritterId;
+use crate::script::host::{with_env, Host};
+use crate::vector::Vector;
+use glam::DVec3;
+use rhai::{Dynamic, Engine, EvalAltResult, INT};
+use std::rc::Rc;
+
+/// A handle to a critter, as scripts see it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CritterRef(pub(crate) CritterId);
+
+/// The error of a handle whose critter died.
+pub(super) fn gone(id: CritterId) -> Box<EvalAltResult> {
+    error(format!(
+        "critter {id} is gone (it died); check `c.alive` before using it"
+    ))
+}
+
+macro_rules! critter_field {
+    ($engine:expr, $host:expr, $name:literal, |$c:ident| $get:expr) => {{
+        let h = $host.clone();
+        $engine.register_get($name, move |r: &mut CritterRef| -> Res<_> {
+            let id = r.0;
+            with_env!(h, env => match env.critter(id) {
+                Some($c) => Ok($get),
+                None => Err(gone(id)),
+            })
+        });
+    }};
+}
+
+macro_rules! critter_setter {
+    ($engine:expr, $host:expr, $name:literal, $ty:ty, |$c:ident, $v:ident| $set:expr) => {{
+        let h = $host.clone();
+        $engine.register_set($name, move |r: &mut CritterRef, $v: $ty| -> Res<()> {
+            let id = r.0;
+            with_env!(h, env => match env.critter_mut(id) {
+                Some($c) => $set,
+                None => if env.critter(id).is_some() {
+                    fail(concat!("critters are read-only in collides_with: ", $name, " cannot be set there"))
+                } else {
+                    Err(gone(id))
+                },
+            })
+        });
+    }};
+}
+
+fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: bool) -> Res<()> {
+    let prop = to_prop(value)?;
+    with_env!(host, env => {
+        let kind = match env.critter(id) {
+            Some(c) => env.kinds().name(c.kind()).to_string(),
+            None => return Err(gone(id)),
+        };
+        match env.critter_mut(id) {
+            Some(c) if create || c.props().contains_key(name) => {
+                c.props_mut().insert(name.to_string(), prop);
+                Ok(())
+            }
+            Some(_) => fail_hint(
+                format!(
+                    "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
+                     health, restitution, priority, fixed)"
+                ),
+                format!(
+                    "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
+                     set_prop(\"{name}\", value)"
+                ),
+            ),
+            None => fail("critters are read-only in collides_with"),
+        }
+    })
+}
+
+fn set_vec<V: Vector>(slot: &mut V, v: DVec3, what: &str) -> Res<()> {
+    if !v.is_finite() {
+        return fail(format!(
+            "{what} = {v}: every component must be a finite number"
+        ));
+    }
+    *slot = from_svec(v);
+    Ok(())
+}
+
+fn set_num(
+    c: &mut f64,
+    v: &Dynamic,
+    what: &str,
+    check: impl Fn(f64) -> bool,
+    rule: &str,
+) -> Res<()> {
+    let x = num_or(v, what)?;
+    if !check(x) {
+        return fail(format!("{what} = {x}: {rule}"));
+    }
+    *c = x;
+    Ok(())
+}
+
+pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+    engine.register_type_with_name::<CritterRef>("Critter");
+    engine.register_fn("==", |a: CritterRef, b: CritterRef| a == b);
+    engine.register_fn("!=", |a: CritterRef, b: CritterRef| a != b);
+    let show = |c: &mut CritterRef| format!("critter {}", c.0);
+    engine.register_fn("to_string", show);
+    engine.register_fn("to_debug", show);
+
+    critter_field!(engine, host, "pos", |c| to_svec(c.pos));
+    critter_field!(engine, host, "vel", |c| to_svec(c.vel));
+    critter_field!(engine, host, "radius", |c| c.radius());
+    critter_field!(engine, host, "mass", |c| c.mass());
+    critter_field!(engine, host, "health", |c| c.health());
+    critter_field!(engine, host, "restitution", |c| c.restitution());
+    critter_field!(engine, host, "priority", |c| c.priority());
+    critter_field!(engine, host, "fixed", |c| c.is_fixed());
+    critter_field!(engine, host, "is_wall", |c| c.is_wall());
+    {
+        // A dead critter's handle answers `alive` with false rather than an error.
+        let h = host.clone();
+        engine.register_get("alive", move |r: &mut CritterRef| -> Res<bool> {
+            let id = r.0;
+            with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.is_alive())))
+        });
+    }
+    critter_field!(engine, host, "id", |c| c.id().index as INT);
+    {
+        let h = host.clone();
+        engine.register_get("kind", move |r: &mut CritterRef| -> Res<String> {
+            let id = r.0;
+            with_env!(h, env => match env.critter(id) {
+                Some(c) => Ok(env.kinds().name(c.kind()).to_string()),
+                None => Err(gone(id)),
+            })
+        });
+    }
+    critter_setter!(engine, host, "pos", DVec3, |c, v| set_vec(
+        &mut c.pos, v, "pos"
+    ));
+    critter_setter!(engine, host, "vel", DVec3, |c, v| set_vec(
+        &mut c.vel, v, "vel"
+    ));
+    critter_setter!(engine, host, "radius", Dynamic, |c, v| c
+        .set_radius(num_or(&v, "radius")?)
+        .map_err(lib_err));
+    critter_setter!(engine, host, "mass", Dynamic, |c, v| c
+        .set_mass(num_or(&v, "mass")?)
+        .map_err(lib_err));
+    critter_setter!(engine, host, "priority", Dynamic, |c, v| c
+        .set_priority(num_or(&v, "priority")?)
+        .map_err(lib_err));
+    critter_setter!(engine, host, "fixed", bool, |c, v| {
+        c.set_fixed(v);
+        Ok(())
+    });
+    critter_setter!(engine, host, "health", Dynamic, |c, v| set_num(
+        &mut c.traits_mut().health,
+        &v,
+        "health",
+        f64::is_finite,
+        "must be a finite number"
+    ));
+    critter_setter!(engine, host, "restitution", Dynamic, |c, v| set_num(
+        &mut c.traits_mut().restitution,
+        &v,
+        "restitution",
+        |e| (0.0..=1.0).contains(&e),
+        "must be between 0 and 1"
+    ));
+
+    // User properties: c["name"], and c.name when no field of that name exists.
+    let h = host.clone();
+    engine.register_indexer_get(move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {
+        let id = r.0;
+        with_env!(h, env => match env.critter(id) {
+            Some(c) => match c.props().get(name) {
+                Some(p) => Ok(from_prop(p)),
+                None => fail(format!(
+                    "critter {id} ({}) has no property '{name}'; give it one in its kind's props or spawn map, or test with has(\"{name}\")",
+                    env.kinds().name(c.kind())
+                )),
+            },
+            None => Err(gone(id)),
+        })
+    });
+    // Setting an existing property, or one the kind or spawn map declared. A new name is an
+    // error, so a typo (`me.velocity = ...`) is caught; `set_prop` adds one on purpose.
+    let h = host.clone();
+    engine.register_indexer_set(
+        move |r: &mut CritterRef, name: &str, value: Dynamic| -> Res<()> {
+            set_prop(&h, r.0, name, &value, false)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "set_prop",
+        move |r: &mut CritterRef, name: &str, value: Dynamic| -> Res<()> {
+            set_prop(&h, r.0, name, &value, true)
+        },
+    );
+    // rhai gives every value a `tag`; for critters, `tag` is a user property like any other.
+    let h = host.clone();
+    engine.register_get("tag", move |r: &mut CritterRef| -> Res<Dynamic> {
+        let id = r.0;
+        with_env!(h, env => match env.critter(id) {
+            Some(c) => c.props().get("tag").map_or_else(
+                || fail(format!("critter {id} has no property 'tag'")),
+                |p| Ok(from_prop(p)),
+            ),
+            None => Err(gone(id)),
+        })
+    });
+    let h = host.clone();
+    engine.register_set(
+        "tag",
+        move |r: &mut CritterRef, value: Dynamic| -> Res<()> {
+            set_prop(&h, r.0, "tag", &value, false)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("has", move |r: &mut CritterRef, name: &str| -> Res<bool> {
+        let id = r.0;
+        with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.props().contains_key(name))))
+    });
+
+    let h = host.clone();
+    engine.register_fn(
+        "is_kind",
+        move |r: &mut CritterRef, kind: &str| -> Res<bool> {
+            let id = r.0;
+            with_env!(h, env => {
+                let kinds = env.kinds();
+                match (env.critter(id), kinds.id(kind)) {
+                    (Some(c), Ok(k)) => Ok(kinds.is_kind(c.kind(), k)),
+                    (None, _) => Err(gone(id)),
+                    // An unknown kind name: nothing is of that kind (it may simply not be loaded).
+                    (Some(_), Err(_)) => Ok(false),
+                }
+            })
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "touches",
+        move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
+            let a = a.0;
+            with_env!(h, env => Ok(env.touches(a, b.0)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "contains",
+        move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
+            let a = a.0;
+            with_env!(h, env => Ok(env.contains(a, b.0)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("distance", move |a: &mut CritterRef, b: CritterRef| -> Res<f64> {
+        let a = a.0;
+        with_env!(h, env => env.distance(a, b.0).map_or_else(|| Err(gone(if env.critter(a).is_none() { a } else { b.0 })), Ok))
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "damage",
+        move |a: &mut CritterRef, amount: Dynamic| -> Res<()> {
+            let a = a.0;
+            let amount = num_or(&amount, "damage")?;
+            with_env!(h, env => {
+                env.damage(a, amount);
+                Ok(())
+            })
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("die", move |a: &mut CritterRef| -> Res<()> {
+        let a = a.0;
+        with_env!(h, env => {
+            env.die(a);
+            Ok(())
+        })
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "collide_default",
+        move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
+            let a = a.0;
+            with_env!(h, env => env.collide_default(a, b.0).or_else(fail))
+        },
+    );
+}

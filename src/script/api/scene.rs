@@ -1,0 +1,433 @@
+//! Building a scene's world from a script: `world(#{ ... })`, `load_kind`, walls
+//! (`wall`, `wall_box`, `walls_around`), spawning patterns (`row`, `ring`, `grid`, `scatter`),
+//! `spawn(kind, #{ ... })` and `stop(reason)`.
+
+use super::critter::CritterRef;
+use super::spawn::{spawn_in, spec_from_map};
+use super::values::{from_svec, num, num_or, to_svec};
+use super::world::WorldRef;
+use super::{error, fail, lib_err, Res};
+use crate::border::Border;
+use crate::scenes::{AnyWorld, Scene};
+use crate::script::env::Env;
+use crate::script::host::{with_env, Host};
+use crate::script::kind::load_into;
+use crate::vector::Vector;
+use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
+use crate::world::{World, WorldConfig};
+use glam::{DMat3, DVec2, DVec3};
+use rhai::{Array, Dynamic, Engine, Map, INT};
+use std::rc::Rc;
+
+/// The keys `world(#{ ... })` accepts.
+const WORLD_KEYS: &[&str] = &[
+    "dim", "size", "min", "border", "gravity", "dt", "seed", "method", "sleep", "steps",
+];
+
+/// Loads kind `name` into whatever world scripts act on, unless it is there already.
+fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<()> {
+    let known = with_env!(host, env => Ok(env.kinds().id(name).is_ok()))?;
+    if known {
+        return Ok(());
+    }
+    let rt = host.runtime()?;
+    with_env!(host, env => match env.world() {
+        Some(world) => load_into(&rt, world, name).map(|_| ()).map_err(|e| host.carry(e)),
+        None => fail(format!(
+            "unknown kind '{name}': kinds are loaded between steps; call load_kind(\"{name}\") in the scene script"
+        )),
+    })
+}
+
+fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
+    let mut size = V::splat(10.0);
+    let mut min = V::zero();
+    let mut config = WorldConfig::new(V::zero(), V::splat(10.0));
+    let mut steps = None;
+    for (key, value) in map {
+        match key.as_str() {
+            "dim" => {}
+            "size" => {
+                size = match num(value) {
+                    Some(s) => V::splat(s),
+                    None => from_svec(vec_arg(value, "size")?),
+                }
+            }
+            "min" => min = from_svec(vec_arg(value, "min")?),
+            "border" => {
+                config.border = value.to_string().parse::<Border>().map_or_else(fail, Ok)?;
+            }
+            "gravity" => config.gravity = from_svec(vec_arg(value, "gravity")?),
+            "dt" => config.dt = num_or(value, "dt")?,
+            "seed" => {
+                config.seed = value.as_int().ok().filter(|s| *s >= 0).map_or_else(
+                    || fail("seed must be a whole number >= 0"),
+                    |s| Ok(s as u64),
+                )?
+            }
+            "method" => {
+                config.method = value
+                    .to_string()
+                    .parse::<crate::method::Method>()
+                    .map_or_else(fail, Ok)?;
+            }
+            "sleep" => {
+                config.sleep = value
+                    .as_bool()
+                    .map_or_else(|_| fail("sleep must be true or false"), Ok)?
+            }
+            "steps" => {
+                steps = Some(value.as_int().ok().filter(|s| *s >= 0).map_or_else(
+                    || fail("steps must be a whole number >= 0"),
+                    |s| Ok(s as u64),
+                )?)
+            }
+            other => {
+                return fail(format!(
+                    "unknown world setting '{other}'; the settings are {}",
+                    WORLD_KEYS.join(", ")
+                ))
+            }
+        }
+    }
+    config.min = min;
+    config.max = min + size;
+    Ok((config, steps))
+}
+
+fn vec_arg(d: &Dynamic, what: &str) -> Res<DVec3> {
+    d.clone().try_cast::<DVec3>().map_or_else(
+        || {
+            fail(format!(
+                "{what} must be a Vec (e.g. vec(20, 10)) or a number"
+            ))
+        },
+        Ok,
+    )
+}
+
+/// `world(#{ dim: 2, size: vec(20, 10), ... })`: makes the scene's world and points scripts at it.
+fn make_world(host: &Rc<Host>, map: &Map) -> Res<WorldRef> {
+    if host.has_scene() {
+        return fail("this scene already made its world; call world(#{ ... }) once");
+    }
+    if host.kind_decl.borrow().is_some() {
+        return fail("a kind file cannot make a world; world(#{ ... }) belongs in a scene script");
+    }
+    let dim = match map.get("dim") {
+        None => 2,
+        Some(d) => d.as_int().map_err(|_| error("dim must be 2 or 3"))?,
+    };
+    let seed = host.seed_override.get();
+    let (any, steps) = match dim {
+        2 => {
+            let (mut c, steps) = config::<DVec2>(map)?;
+            c.seed = seed.unwrap_or(c.seed);
+            (AnyWorld::D2(World::new(c).map_err(lib_err)?), steps)
+        }
+        3 => {
+            let (mut c, steps) = config::<DVec3>(map)?;
+            c.seed = seed.unwrap_or(c.seed);
+            (AnyWorld::D3(World::new(c).map_err(lib_err)?), steps)
+        }
+        other => return fail(format!("dim must be 2 or 3, not {other}")),
+    };
+    host.scene_steps.set(steps);
+    host.put_scene(Scene::new("world", any, steps.unwrap_or(600)))?;
+    Ok(WorldRef)
+}
+
+/// Runs `f` on the world between steps, or fails with `what` inside a step.
+macro_rules! on_world {
+    ($host:expr, $what:expr, $w:ident => $body:expr) => {
+        with_env!($host, env => match env.world() {
+            Some($w) => $body,
+            None => fail(concat!($what, " works in scene scripts (top level and on_step), not inside a kind's hooks")),
+        })
+    };
+}
+
+fn add_wall_2d_or_3d<V: Vector>(w: &mut World<V>, wall: Res<WallBox<V>>) -> Res<CritterRef> {
+    let id = w.add_wall(wall?).map_err(lib_err)?;
+    Ok(CritterRef(id))
+}
+
+fn segment<V: Vector>(a: DVec3, b: DVec3, t: f64) -> Res<WallBox<V>> {
+    if V::DIM != 2 {
+        return fail("wall(a, b) is for 2D worlds; in 3D use wall_box(min, max)");
+    }
+    let wall = WallBox::segment(DVec2::new(a.x, a.y), DVec2::new(b.x, b.y), t).map_err(lib_err)?;
+    let any: Box<dyn std::any::Any> = Box::new(wall);
+    any.downcast::<WallBox<V>>()
+        .map(|w| *w)
+        .map_or_else(|_| fail("wall(a, b) is for 2D worlds"), Ok)
+}
+
+fn dim_of<V: Vector>(_: &dyn Env<V>) -> usize {
+    V::DIM
+}
+
+/// Walls of thickness `t` lining the inside of the world box.
+fn walls_around<V: Vector>(w: &mut World<V>, t: f64) -> Res<Array> {
+    let (min, max) = (w.topology().min, w.topology().max);
+    let mut out = Array::new();
+    for axis in 0..V::DIM {
+        for low in [true, false] {
+            let (mut lo, mut hi) = (min, max);
+            if low {
+                hi.set(axis, min.get(axis) + t);
+            } else {
+                lo.set(axis, max.get(axis) - t);
+            }
+            let wall = WallBox::aligned(lo, hi).map_err(lib_err)?;
+            out.push(Dynamic::from(CritterRef(
+                w.add_wall(wall).map_err(lib_err)?,
+            )));
+        }
+    }
+    Ok(out)
+}
+
+pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+    let h = host.clone();
+    engine.register_fn("world", move |map: Map| make_world(&h, &map));
+    let h = host.clone();
+    engine.register_fn("load_kind", move |name: &str| -> Res<()> {
+        ensure_kind(&h, name)
+    });
+
+    let h = host.clone();
+    engine.register_fn(
+        "wall",
+        move |_: &mut WorldRef, a: DVec3, b: DVec3| -> Res<CritterRef> {
+            on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, DEFAULT_WALL_THICKNESS)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "wall",
+        move |_: &mut WorldRef, a: DVec3, b: DVec3, t: Dynamic| -> Res<CritterRef> {
+            let t = num_or(&t, "wall thickness")?;
+            on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, t)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("wall_box", move |_: &mut WorldRef, lo: DVec3, hi: DVec3| -> Res<CritterRef> {
+        on_world!(h, "wall_box", w => add_wall_2d_or_3d(w, WallBox::aligned(from_svec(lo), from_svec(hi)).map_err(lib_err)))
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "wall_box",
+        move |_: &mut WorldRef, center: DVec3, size: DVec3, angle: Dynamic| -> Res<CritterRef> {
+            let angle = num_or(&angle, "wall_box angle")?;
+            on_world!(h, "wall_box", w => {
+                let rot = DMat3::from_rotation_z(angle);
+                let wall = rotated_box(from_svec(center), size, rot);
+                add_wall_2d_or_3d(w, wall)
+            })
+        },
+    );
+    let h = host.clone();
+    engine.register_fn("walls_around", move |_: &mut WorldRef| -> Res<Array> {
+        on_world!(h, "walls_around", w => walls_around(w, DEFAULT_WALL_THICKNESS))
+    });
+    let h = host.clone();
+    engine.register_fn(
+        "walls_around",
+        move |_: &mut WorldRef, t: Dynamic| -> Res<Array> {
+            let t = num_or(&t, "wall thickness")?;
+            on_world!(h, "walls_around", w => walls_around(w, t))
+        },
+    );
+
+    // Spawning patterns (scene scripts; kinds load on first use).
+    let h = host.clone();
+    engine.register_fn(
+        "row",
+        move |_: &mut WorldRef,
+              kind: &str,
+              start: DVec3,
+              step: DVec3,
+              count: INT,
+              map: Map|
+              -> Res<Array> {
+            let positions = (0..count.max(0)).map(|i| start + step * i as f64);
+            spawn_at(&h, kind, &map, positions)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "ring",
+        move |_: &mut WorldRef,
+              kind: &str,
+              center: DVec3,
+              radius: Dynamic,
+              count: INT,
+              map: Map|
+              -> Res<Array> {
+            let r = num_or(&radius, "ring radius")?;
+            let positions = (0..count.max(0)).map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / count as f64;
+                center + DVec3::new(r * a.cos(), r * a.sin(), 0.0)
+            });
+            spawn_at(&h, kind, &map, positions)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "grid",
+        move |_: &mut WorldRef,
+              kind: &str,
+              lo: DVec3,
+              hi: DVec3,
+              spacing: Dynamic,
+              map: Map|
+              -> Res<Array> {
+            let s = num_or(&spacing, "grid spacing")?;
+            if !(s > 0.0 && s.is_finite()) {
+                return fail(format!("grid spacing {s} must be a finite number > 0"));
+            }
+            let dim = with_env!(h, env => Ok(dim_of(env)))?;
+            let count = |a: f64, b: f64| ((b - a) / s).floor().max(0.0) as i64 + 1;
+            let (nx, ny, nz) = (
+                count(lo.x, hi.x),
+                count(lo.y, hi.y),
+                if dim == 3 { count(lo.z, hi.z) } else { 1 },
+            );
+            if nx * ny * nz > 10_000_000 {
+                return fail("that grid would hold more than 10 million critters");
+            }
+            let positions = (0..nz).flat_map(|k| {
+                (0..ny).flat_map(move |j| {
+                    (0..nx).map(move |i| lo + DVec3::new(i as f64 * s, j as f64 * s, k as f64 * s))
+                })
+            });
+            spawn_at(&h, kind, &map, positions)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "scatter",
+        move |_: &mut WorldRef, kind: &str, count: INT, map: Map| -> Res<Array> {
+            ensure_kind(&h, kind)?;
+            let mut out = Array::new();
+            for _ in 0..count.max(0) {
+                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, kind, &map))?);
+            }
+            Ok(out)
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "stop",
+        move |_: &mut WorldRef, reason: Dynamic| -> Res<()> {
+            *h.stop.borrow_mut() = Some(reason.to_string());
+            Ok(())
+        },
+    );
+    // spawn(kind, #{ ... }). `spawn` is a reserved word in rhai, so it is custom syntax: now
+    // between steps (loading the kind on first use), queued inside a step.
+    let h = host.clone();
+    let registered = engine.register_custom_syntax(
+        ["spawn", "(", "$expr$", ",", "$expr$", ")"],
+        false,
+        move |ctx, inputs| {
+            // Errors raised here have no position of their own: give them the spawn's.
+            let pos = inputs[0].position();
+            spawn_syntax(&h, ctx, inputs).map_err(|mut e| {
+                if e.position().is_none() {
+                    e.set_position(pos);
+                }
+                e
+            })
+        },
+    );
+    debug_assert!(registered.is_ok());
+}
+
+fn spawn_syntax(
+    h: &Rc<Host>,
+    ctx: &mut rhai::EvalContext,
+    inputs: &[rhai::Expression],
+) -> Res<Dynamic> {
+    let kind = ctx.eval_expression_tree(&inputs[0])?;
+    let map = ctx.eval_expression_tree(&inputs[1])?;
+    let Some(kind) = kind.clone().try_cast::<rhai::ImmutableString>() else {
+        return fail(format!(
+            "spawn's first argument is the kind's name, not {}",
+            kind.type_name()
+        ));
+    };
+    let Some(map) = map.clone().try_cast::<Map>() else {
+        return fail(format!(
+            "spawn's second argument is a map like #{{ pos: vec(1, 2) }}, not {}",
+            map.type_name()
+        ));
+    };
+    let in_world = with_env!(h, env => Ok(env.world().is_some()))?;
+    if in_world {
+        ensure_kind(h, &kind)?;
+    }
+    with_env!(h, env => spawn_in(env, h, &kind, &map))
+}
+
+fn rotated_box<V: Vector>(center: V, size: DVec3, rot: DMat3) -> Res<WallBox<V>> {
+    let any: &dyn std::any::Any = &rot;
+    let frame = if V::DIM == 3 {
+        any.downcast_ref::<V::Frame>().copied()
+    } else {
+        let dir = DVec2::new(rot.x_axis.x, rot.x_axis.y);
+        let d: &dyn std::any::Any = &dir;
+        d.downcast_ref::<V::Frame>().copied()
+    };
+    let frame = frame.map_or_else(|| fail("cannot orient that wall"), Ok)?;
+    WallBox::new(center, from_svec::<V>(size) * 0.5, frame).map_err(lib_err)
+}
+
+/// One critter of `kind` at each position, with the rest of `map` (the kind loads on first use).
+fn spawn_at(
+    host: &Rc<Host>,
+    kind: &str,
+    map: &Map,
+    positions: impl Iterator<Item = DVec3>,
+) -> Res<Array> {
+    ensure_kind(host, kind)?;
+    let mut out = Array::new();
+    for p in positions {
+        let mut m = map.clone();
+        m.insert("pos".into(), Dynamic::from(p));
+        out.push(with_env!(host, env => spawn_in(env, host, kind, &m))?);
+    }
+    Ok(out)
+}
+
+/// One critter at a random free place in the world box (seeded), clear of walls and critters.
+fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) -> Res<Dynamic> {
+    let spec = spec_from_map::<V>(kind, map)?;
+    let kid = w.kinds().id(kind).map_err(lib_err)?;
+    let r = spec.radius.unwrap_or(w.kinds().get(kid).defaults.radius);
+    let (min, max) = (w.topology().min, w.topology().max);
+    for _ in 0..1000 {
+        let mut p = V::zero();
+        for axis in 0..V::DIM {
+            p.set(axis, w.rng().uniform(min.get(axis) + r, max.get(axis) - r));
+        }
+        let free = w.critters().iter().all(|c| {
+            let d = w.topology().delta(c.pos, p);
+            match c.wall() {
+                Some(wall) => crate::contact::contact_wall_ball(wall, d, r).is_none(),
+                None => d.length() > c.radius() + r,
+            }
+        });
+        if free {
+            let mut m = map.clone();
+            m.insert("pos".into(), Dynamic::from(to_svec(p)));
+            let spec = spec_from_map::<V>(kind, &m)?;
+            let id = w.spawn(spec).map_err(|e| host.carry(e))?;
+            return Ok(Dynamic::from(CritterRef(id)));
+        }
+    }
+    fail(format!(
+        "no free place for another {kind} after 1000 tries: the world is too full"
+    ))
+}

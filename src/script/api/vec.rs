@@ -1,0 +1,56 @@
+//! `Vec`: a 3-vector with operators and the usual functions; 2D worlds ignore z.
+
+use super::values::num_or;
+use super::Res;
+use glam::DVec3;
+use rhai::{Dynamic, Engine, INT};
+
+pub(super) fn register(engine: &mut Engine) {
+    engine.register_type_with_name::<DVec3>("Vec");
+    engine.register_fn("vec", |x: Dynamic, y: Dynamic| -> Res<DVec3> {
+        Ok(DVec3::new(num_or(&x, "x")?, num_or(&y, "y")?, 0.0))
+    });
+    engine.register_fn("vec", |x: Dynamic, y: Dynamic, z: Dynamic| -> Res<DVec3> {
+        Ok(DVec3::new(
+            num_or(&x, "x")?,
+            num_or(&y, "y")?,
+            num_or(&z, "z")?,
+        ))
+    });
+    engine.register_get_set("x", |v: &mut DVec3| v.x, |v: &mut DVec3, x: f64| v.x = x);
+    engine.register_get_set("y", |v: &mut DVec3| v.y, |v: &mut DVec3, y: f64| v.y = y);
+    engine.register_get_set("z", |v: &mut DVec3| v.z, |v: &mut DVec3, z: f64| v.z = z);
+    engine.register_fn("+", |a: DVec3, b: DVec3| a + b);
+    engine.register_fn("-", |a: DVec3, b: DVec3| a - b);
+    engine.register_fn("-", |a: DVec3| -a);
+    engine.register_fn("*", |a: DVec3, k: f64| a * k);
+    engine.register_fn("*", |k: f64, a: DVec3| a * k);
+    engine.register_fn("*", |a: DVec3, k: INT| a * k as f64);
+    engine.register_fn("*", |k: INT, a: DVec3| a * k as f64);
+    engine.register_fn("/", |a: DVec3, k: f64| a / k);
+    engine.register_fn("/", |a: DVec3, k: INT| a / k as f64);
+    engine.register_fn("==", |a: DVec3, b: DVec3| a == b);
+    engine.register_fn("!=", |a: DVec3, b: DVec3| a != b);
+    engine.register_fn("+=", |a: &mut DVec3, b: DVec3| *a += b);
+    engine.register_fn("-=", |a: &mut DVec3, b: DVec3| *a -= b);
+    engine.register_fn("length", |a: &mut DVec3| a.length());
+    engine.register_fn("length_squared", |a: &mut DVec3| a.length_squared());
+    engine.register_fn("normalize", |a: &mut DVec3| a.normalize_or_zero());
+    engine.register_fn("dot", |a: &mut DVec3, b: DVec3| a.dot(b));
+    engine.register_fn("cross", |a: &mut DVec3, b: DVec3| a.cross(b));
+    engine.register_fn("distance", |a: &mut DVec3, b: DVec3| a.distance(b));
+    engine.register_fn("perp", |a: &mut DVec3| DVec3::new(-a.y, a.x, 0.0));
+    engine.register_fn("rotate", |a: &mut DVec3, angle: f64| {
+        let (s, c) = angle.sin_cos();
+        DVec3::new(c * a.x - s * a.y, s * a.x + c * a.y, a.z)
+    });
+    let show = |a: &mut DVec3| -> String {
+        if a.z == 0.0 {
+            format!("vec({}, {})", a.x, a.y)
+        } else {
+            format!("vec({}, {}, {})", a.x, a.y, a.z)
+        }
+    };
+    engine.register_fn("to_string", show);
+    engine.register_fn("to_debug", show);
+}

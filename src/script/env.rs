@@ -1,0 +1,161 @@
+//! What a script may do to the world it runs in: the [`Env`] trait, and its implementations for
+//! the whole [`World`] (scene setup, `on_step`) and for a hook's [`Access`] (inside a step). The
+//! read-only view `collides_with` gets is in [`super::kind`].
+
+use crate::border::Topology;
+use crate::context::Access;
+use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::error::Error;
+use crate::kind::{KindId, KindSet};
+use crate::rng::Rng;
+use crate::vector::Vector;
+use crate::world::World;
+
+/// What a script may do to the world it runs in.
+pub(crate) trait Env<V: Vector> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>>;
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>>;
+    fn kinds(&self) -> &KindSet<V>;
+    fn topology(&self) -> &Topology<V>;
+    fn step_count(&self) -> u64;
+    fn time(&self) -> f64;
+    fn dt(&self) -> f64;
+    fn rng(&mut self) -> &mut Rng;
+    fn die(&mut self, id: CritterId);
+    fn damage(&mut self, id: CritterId, amount: f64);
+    /// Spawns now (`Some(id)`) between steps, or queues for the end of the step (`None`).
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error>;
+    fn log(&mut self, line: String);
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
+    fn touches(&self, a: CritterId, b: CritterId) -> bool {
+        match (self.critter(a), self.critter(b)) {
+            (Some(x), Some(y)) => crate::response::touches(self.topology(), x, y),
+            _ => false,
+        }
+    }
+    fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
+        match (self.critter(outer), self.critter(inner)) {
+            (Some(o), Some(i)) => crate::response::contains(self.topology(), o, i),
+            _ => false,
+        }
+    }
+    fn distance(&self, a: CritterId, b: CritterId) -> Option<f64> {
+        let (x, y) = (self.critter(a)?, self.critter(b)?);
+        Some(self.topology().delta(x.pos, y.pos).length())
+    }
+    /// The default response; `Err` outside a step.
+    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
+    /// The world itself, between steps (scene setup and `on_step`).
+    fn world(&mut self) -> Option<&mut World<V>>;
+}
+
+impl<V: Vector> Env<V> for World<V> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.get(id)
+    }
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.get_mut(id)
+    }
+    fn kinds(&self) -> &KindSet<V> {
+        World::kinds(self)
+    }
+    fn topology(&self) -> &Topology<V> {
+        World::topology(self)
+    }
+    fn step_count(&self) -> u64 {
+        World::step_count(self)
+    }
+    fn time(&self) -> f64 {
+        World::time(self)
+    }
+    fn dt(&self) -> f64 {
+        World::dt(self)
+    }
+    fn rng(&mut self) -> &mut Rng {
+        World::rng(self)
+    }
+    fn die(&mut self, id: CritterId) {
+        // Between steps a death takes effect at once.
+        let _ = self.remove(id);
+    }
+    fn damage(&mut self, id: CritterId, amount: f64) {
+        let dead = match self.get_mut(id) {
+            Some(c) => {
+                c.traits_mut().health -= amount;
+                c.health() <= 0.0
+            }
+            None => false,
+        };
+        if dead {
+            let _ = self.remove(id);
+        }
+    }
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
+        World::spawn(self, spec).map(Some)
+    }
+    fn log(&mut self, line: String) {
+        self.log_line(line);
+    }
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
+        self.critters()
+            .iter()
+            .filter(|c| c.is_alive() && World::kinds(self).is_kind(c.kind(), kind))
+            .map(|c| c.id())
+            .collect()
+    }
+    fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
+        Err("collide_default can only be called inside a collide hook".into())
+    }
+    fn world(&mut self) -> Option<&mut World<V>> {
+        Some(self)
+    }
+}
+
+impl<V: Vector> Env<V> for Access<'_, V> {
+    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
+        self.get(id)
+    }
+    fn critter_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.get_mut(id)
+    }
+    fn kinds(&self) -> &KindSet<V> {
+        Access::kinds(self)
+    }
+    fn topology(&self) -> &Topology<V> {
+        Access::topology(self)
+    }
+    fn step_count(&self) -> u64 {
+        self.step()
+    }
+    fn time(&self) -> f64 {
+        Access::time(self)
+    }
+    fn dt(&self) -> f64 {
+        Access::dt(self)
+    }
+    fn rng(&mut self) -> &mut Rng {
+        Access::rng(self)
+    }
+    fn die(&mut self, id: CritterId) {
+        Access::die(self, id)
+    }
+    fn damage(&mut self, id: CritterId, amount: f64) {
+        Access::damage(self, id, amount)
+    }
+    fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
+        Access::spawn(self, spec);
+        Ok(None)
+    }
+    fn log(&mut self, line: String) {
+        Access::log(self, line)
+    }
+    fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
+        Access::critters_of(self, kind)
+    }
+    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String> {
+        Ok(self.collide_default_pair(caller, arg).is_some())
+    }
+    fn world(&mut self) -> Option<&mut World<V>> {
+        None
+    }
+}

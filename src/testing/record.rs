@@ -1,0 +1,164 @@
+//! A test's run as a recording: every test's run is recorded while it runs and kept only when
+//! it fails; `expect_matches_recording(path)` compares the run with a golden recording, or
+//! with `--bless` writes it.
+
+use super::run::TestRun;
+use super::world::{flat, with_scene};
+use crate::recording::{EndMeta, Recorder, Recording, RunMeta, RunOverrides, SceneSource};
+use crate::scenes::AnyWorld;
+use crate::script::api::{error, fail, Res};
+use crate::script::host::Host;
+use rhai::{Engine, EvalAltResult};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// How a recording of `world` ends: `outcome` ("completed", "error") and why.
+fn end_meta(world: &AnyWorld, outcome: &str, reason: String) -> EndMeta {
+    EndMeta {
+        steps: world.step_count(),
+        outcome: outcome.into(),
+        reason,
+        hash: world.state_hash(),
+    }
+}
+
+/// Starts recording the test's scene, if failures are to be recorded.
+pub(super) fn start(host: &Host, run: &TestRun) -> Res<()> {
+    let Some((path, case)) = run.record_to.clone() else {
+        return Ok(());
+    };
+    let rec = with_scene(host, |scene| {
+        let overrides = RunOverrides {
+            limits: run.limits.clone(),
+            ..RunOverrides::default()
+        };
+        let mut meta = RunMeta::for_scene(scene, &overrides);
+        if scene.sources.is_empty() {
+            // Built by the test function itself: no scene to rebuild it from.
+            meta.source = SceneSource::Test { case: case.clone() };
+        }
+        Recorder::create(&path, &meta, &scene.sources, &scene.world)
+    })?;
+    match rec {
+        Ok(rec) => *run.recorder.borrow_mut() = Some(rec),
+        // Not being able to record is not the test's failure; say so and go on.
+        Err(e) => eprintln!(
+            "warning: cannot record the test's run at {}: {e}",
+            path.display()
+        ),
+    }
+    Ok(())
+}
+
+/// Records the step just taken.
+pub(super) fn step(host: &Host, run: &TestRun) -> Res<()> {
+    let mut slot = run.recorder.borrow_mut();
+    if let Some(rec) = slot.as_mut() {
+        let failed = with_scene(host, |scene| rec.record(&scene.world).is_err())?;
+        if failed {
+            *slot = None; // stop recording; the test itself goes on
+        }
+    }
+    Ok(())
+}
+
+/// Ends the recording of a test that ended with `failure` (`None`: it passed). A failed test's
+/// recording is kept, and its path returned; a passed test's is removed.
+pub(super) fn finish(
+    rec: Recorder,
+    world: &AnyWorld,
+    failure: Option<&EvalAltResult>,
+) -> Option<String> {
+    match failure {
+        Some(e) => rec
+            .finish(world, end_meta(world, "error", e.to_string()))
+            .ok()
+            .map(|w| w.path.display().to_string()),
+        None => {
+            let path = rec.path().to_path_buf();
+            drop(rec.finish(world, end_meta(world, "completed", String::new())));
+            let _ = std::fs::remove_file(path);
+            None
+        }
+    }
+}
+
+/// `expect_matches_recording(path)`: the run from here matches the golden recording's state
+/// hash at every step; with `--bless`, the run is recorded as the new golden file instead.
+fn expect_matches_recording(host: &Host, run: &TestRun, path: &str) -> Res<()> {
+    let file = PathBuf::from(path);
+    if run.bless {
+        return bless(host, run, &file, path);
+    }
+    let golden = Recording::open(&file).map_or_else(
+        |e| fail(format!("cannot read the golden recording {path}: {e:#} (make it with `critterbox test --bless`)")),
+        Ok,
+    )?;
+    if let Err(e) = golden.check_state_hash() {
+        return fail(format!("{e:#}: rerun with --bless"));
+    }
+    let Some(&last) = golden.hashes.keys().next_back() else {
+        return fail(format!("the golden recording {path} holds no steps"));
+    };
+    loop {
+        let (step, hash) = with_scene(host, |s| (s.world.step_count(), s.world.state_hash()))?;
+        if let Some(&want) = golden.hashes.get(&step) {
+            if want != hash {
+                return fail(format!(
+                    "the run differs from {path} at step {step} (state hash {hash:016x}, recorded {want:016x}); if the change is intended, rerun with --bless"
+                ));
+            }
+        }
+        if step >= last {
+            return Ok(());
+        }
+        run.check_deadline()?;
+        let stop = with_scene(host, |s| s.step())?.map_err(|e| error(flat(&e)))?;
+        if stop.is_some() && step + 1 < last {
+            return fail(format!(
+                "the scene stopped at step {} but {path} goes on to step {last}",
+                step + 1
+            ));
+        }
+    }
+}
+
+/// `--bless`: runs the scene its default steps, recording it as the golden file `file`.
+fn bless(host: &Host, run: &TestRun, file: &Path, path: &str) -> Res<()> {
+    let steps = with_scene(host, |s| s.default_steps)?;
+    let rec = with_scene(host, |scene| {
+        let overrides = RunOverrides {
+            steps: Some(steps),
+            limits: run.limits.clone(),
+            // Only the hashes are compared: full states at the start and the end keep it small.
+            record_every: Some(steps.max(1)),
+            ..RunOverrides::default()
+        };
+        let meta = RunMeta::for_scene(scene, &overrides);
+        Recorder::create(file, &meta, &scene.sources, &scene.world)
+    })?;
+    let mut rec = rec.map_or_else(
+        |e| fail(format!("cannot write the golden recording {path}: {e}")),
+        Ok,
+    )?;
+    while with_scene(host, |s| s.world.step_count())? < steps {
+        run.check_deadline()?;
+        let stop = with_scene(host, |s| s.step())?.map_err(|e| error(flat(&e)))?;
+        with_scene(host, |s| rec.record(&s.world))?.map_or_else(|e| fail(e.to_string()), Ok)?;
+        if stop.is_some() {
+            break;
+        }
+    }
+    with_scene(host, |s| {
+        rec.finish(&s.world, end_meta(&s.world, "completed", String::new()))
+    })?
+    .map_or_else(|e| fail(e.to_string()), Ok)?;
+    Ok(())
+}
+
+pub(super) fn register(engine: &mut Engine, host: &Rc<Host>, run: &Rc<TestRun>) {
+    let (h, test) = (host.clone(), run.clone());
+    engine.register_fn("expect_matches_recording", move |path: &str| -> Res<()> {
+        expect_matches_recording(&h, &test, path)
+    });
+}
