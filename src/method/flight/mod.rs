@@ -1,0 +1,542 @@
+//! The event engine shared by `swept` and `event`: critters fly (straight, or on parabolas under
+//! uniform acceleration) between events, and events are processed in time order.
+//!
+//! Events ([`events`]): pair collisions, wall hits, border hits (bounce and clamp borders,
+//! [`border`]) and cell crossings (Rapaport, J. Comput. Phys. 34, 1980; [`cells`]): the world
+//! box is cut into cells at least one diameter wide, a critter predicts collisions only with
+//! critters in its own and the neighbouring cells, and crossing into a new cell is an event that
+//! predicts against the new neighbours (keeping the critter's earliest contact for the old
+//! ones). Each critter keeps its own clock (it is advanced only when it takes part in an event)
+//! and a count of its flight's changes; an event stores its critters' counts when predicted,
+//! and a partner's changed count sends the owner to predict again. Each critter has one pending
+//! event, in the queue of `crate::method::queue`, which orders by time, then owner; a critter's
+//! candidates are ordered by time, then ids, then kind ([`predict`](mod@predict)).
+//!
+//! Straight 3D flights without walls use neighbour shells instead (Smallenburg, Eur. Phys. J. E
+//! 45, 22, 2022; [`shells`]): a sphere lists the spheres whose shells overlap its own, predicts
+//! against that list, and leaving its shell is the event that lists it again; a shell's list
+//! holds far fewer candidates than the 27 cells around a sphere.
+//!
+//! Finite precision (Bannerman et al., arXiv:1211.6718): collisions are predicted for a contact
+//! distance a hair (`SKIN`, relative) inside the true one, so at the predicted time the pair
+//! really touches and the response sees it; a pair found overlapping is collided at once (when
+//! it approaches, that is the Bannerman rule; when it separates, the response only separates).
+//!
+//! Inelastic collapse: a collision within `TC_FRACTION x dt` of either critter's previous one is
+//! elastic (the TC model of Luding and McNamara), which stops the infinite sequence of ever
+//! shorter intervals. An event budget per step bounds the cost of what remains (resting
+//! contacts under gravity); when it runs out (counted in `StepStats::budget_exceeded`) the
+//! critters are stopped where they are, and `swept` and `event` finish the step in discrete
+//! substeps short enough not to tunnel.
+//!
+//! Kept flights ([`kept`]): an event step whose flights are straight lines (no gravity) and in
+//! which everyone predicts keeps its flight for the next step: the pending events stay in the
+//! queue (their predictions look ahead to the end of the flight's life, not just the step's),
+//! and the next step predicts again only the critters that something outside the flight changed
+//! between the steps (a hook, the caller), found by comparing each critter with its body. A step
+//! that cannot go on (a critter came, went or changed size or class, a wall moved, the step's
+//! length or the method changed) sets up a new flight. A flight lives at most [`FLIGHT_STEPS`]
+//! steps: it is set up anew at every step whose number is a multiple of it, so that a run
+//! restored from a recorded state at such a step flies exactly as the recorded run did.
+//!
+//! The files: this one holds the flight's state ([`Scratch`]), [`run`] and the loop that
+//! processes events; [`setup`](mod@setup) sets a new flight up ([`bodies`] are what it knows
+//! of each critter); [`predict`](mod@predict) finds a critter's next event.
+
+mod bodies;
+mod border;
+mod cells;
+mod events;
+mod kept;
+mod predict;
+mod setup;
+mod shells;
+#[cfg(test)]
+mod tests;
+
+use crate::error::Error;
+use crate::method::queue::Queue;
+use crate::pairs::pair_key;
+use crate::rules::roles_order;
+use crate::vector::Vector;
+use crate::world::state::{at_step, State};
+use crate::world::stats::StepStats;
+use bodies::{advance, refresh_body, Body, Status};
+use border::bounce_border;
+use cells::{cross_cell, relocate, StripedLists};
+use events::{prefetch_event, validity, Event, EventKind, Validity};
+use kept::{fly_kept, steps_to_live, take_up_kept, KeptFlight};
+use predict::{predict, predict_after_crossing};
+use setup::{mark_who_may_meet, setup};
+use shells::{relist, ShellCentre};
+
+pub use kept::{CHURN, FLIGHT_STEPS};
+
+/// Relative shrink of contact distances used for prediction: at the predicted time the pair
+/// really touches, whatever the rounding.
+pub const SKIN: f64 = 1e-10;
+/// Collisions closer than this fraction of dt to the critter's previous one are elastic: far
+/// below any time scale of the motion, and it stops inelastic collapse.
+pub const TC_FRACTION: f64 = 1e-9;
+/// Events per critter per step before the step falls back to discrete substeps: bounds the cost
+/// of resting contacts under gravity, which never run out of events.
+pub const BUDGET_PER_CRITTER: u64 = 64;
+/// Neighbour shells' thickness, as a fraction of the largest diameter: thinner shells are
+/// left more often, thicker ones list more partners (`docs/methods.md` has the trade).
+pub const SHELL_FRACTION: f64 = 0.6;
+
+/// A relative margin far above the rounding of a few operations on f64s, for bounds that must
+/// hold whatever the rounding.
+const ROUNDING_MARGIN: f64 = 1e-9;
+
+/// An unset slot, cell or partner (above every slot).
+const UNSET: u32 = u32::MAX;
+/// In `last_partner`, the border side `s` a critter last bounced off is `BORDER_PARTNER + s`
+/// (above every slot, below `UNSET`).
+const BORDER_PARTNER: u32 = u32::MAX - 16;
+
+/// Per-world scratch kept between steps so a step allocates nothing once warmed up.
+#[derive(Default)]
+pub(crate) struct Scratch<V: Vector> {
+    /// What a pair test reads of each critter (see [`Body`]).
+    body: Vec<Body<V>>,
+    /// The rest of what the flight knows of each critter (see [`Status`]).
+    status: Vec<Status>,
+    /// Each critter's cell key.
+    cell: Vec<u32>,
+    /// The coordinates of each critter's cell (`cell` unpacked, saving divisions).
+    coord: Vec<[i64; 3]>,
+    /// The partner of each critter's last collision, or the border it last bounced off
+    /// (`BORDER_PARTNER + side`), or `UNSET`: a pair touching at once is not handed back.
+    last_partner: Vec<u32>,
+    /// When each critter last collided (for the TC model).
+    last_collision: Vec<f64>,
+    /// The disks in each cell.
+    cells: StripedLists,
+    /// The walls each cell must test (a disk centred in it could touch them).
+    cell_walls: Vec<Vec<u32>>,
+    /// Some wall is alive (otherwise `cell_walls` is not read).
+    has_walls: bool,
+    /// Neighbour shells instead of cell crossings (Smallenburg's scheme): the cells hold each
+    /// critter by its shell's centre, `neighbours` lists the critters whose shells overlap, and
+    /// leaving the shell is the event that lists again.
+    shells: bool,
+    /// The shell's thickness: a critter stays within `shell_width / 2` of its shell's centre.
+    shell_width: f64,
+    /// The largest radius the cells and shells are sized for.
+    largest_radius: f64,
+    /// The next flight sizes its cells for at least this radius (set when a hook grew a
+    /// critter beyond the last flight's cells).
+    grown_radius: f64,
+    /// When set, a critter that moves less than this in the flight predicts at its start only
+    /// if it may meet something (see [`run`]).
+    slow_below: Option<f64>,
+    /// With `slow_below`, at the flight's start: how far each critter can move in it (`reach`),
+    /// and whether it may meet something (`meets`, found by `mark_who_may_meet`).
+    reach: Vec<f64>,
+    meets: Vec<bool>,
+    /// Per cell: a wall is listed in the cell or one around it.
+    near_wall: Vec<bool>,
+    /// Cells only, even where shells would pay (tests compare the two).
+    #[cfg(test)]
+    no_shells: bool,
+    /// A new flight every step, even where it could be kept (tests compare the two).
+    #[cfg(test)]
+    no_keep: bool,
+    /// Each critter's shell centre (its position when it was last listed) beside its radius.
+    shell_centres: Vec<ShellCentre<V>>,
+    /// A copy of the neighbour list `predict` walks (kept to save allocations).
+    partners: Vec<u32>,
+    /// The candidates `relist` gathers from the cells around (kept to save allocations).
+    gathered: Vec<u32>,
+    /// Each critter's neighbours (the critters whose shells overlap its own), symmetric.
+    neighbours: StripedLists,
+    /// Each critter's next event.
+    queue: Queue<Event>,
+    /// The earliest event found so far by the running prediction.
+    earliest: Option<Event>,
+    /// Pairs whose hook left them overlapping this step: not handed back at once again.
+    stuck: std::collections::HashSet<u64>,
+    /// Cells along each axis (1 beyond the world's dimension).
+    dims: [usize; 3],
+    /// A cell's width along each axis.
+    cell_side: [f64; 3],
+    /// Key offsets of the 3^D cells around an interior cell (none when an axis has fewer than
+    /// three cells: neighbours then repeat, and the general path dedups them).
+    offsets: Vec<isize>,
+    /// The positive ones among `offsets`: the cells after an interior cell, with which
+    /// `mark_who_may_meet` pairs it (each pair of neighbouring cells once).
+    forward: Vec<isize>,
+    /// Per axis and direction (`axis * 2 + dir`), the offsets among `offsets` of the cells a
+    /// crossing that way brings into reach.
+    front: [Vec<isize>; 6],
+    /// Each critter's earliest pair or wall event from its last prediction, kept so that a cell
+    /// crossing only has to look at the cells it brings into reach (Rapaport's scheme).
+    earliest_contact: Vec<Option<Event>>,
+    /// The acceleration of free critters.
+    acc: V,
+    /// No acceleration: every flight is a straight line.
+    straight: bool,
+    /// How far ahead (in flight time) predictions look: the step's end, or the end of a kept
+    /// flight's life.
+    horizon: f64,
+    /// A collision this soon after either critter's last is elastic (the TC model).
+    tc_window: f64,
+    /// Events the flight may process before it stops.
+    budget: u64,
+    /// Predictions made and pair tests run in this flight (for the step's stats).
+    predictions: u64,
+    pair_tests: u64,
+    /// Sum over default collisions of contact distance x impulse (the collision virial).
+    pub virial: f64,
+    /// The flight kept for the next step, if it may go on.
+    kept: Option<KeptFlight>,
+    /// The flight time the last flight ended at.
+    ended_at: f64,
+    /// A hook grew a critter beyond the cells in this step (the flight was set up again).
+    outgrown: bool,
+    /// The critters changed between two steps of a kept flight (kept to save allocations).
+    changed: Vec<u32>,
+    /// The step at which the last event step that could have kept its flight could not, or had
+    /// to predict more than [`CHURN`] of its critters again: something outside the flight
+    /// changes critters every step (hooks steering them, spawns), and the kept flight does not
+    /// pay (`auto` reads it). `None` when the last such step kept its flight.
+    churned_at: Option<u64>,
+}
+
+/// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
+/// processing every event in order. Returns `None` when every event was processed, or the time
+/// the event budget ran out, where the critters were stopped (the caller finishes the step).
+///
+/// `slow_below`: when set, a critter that moves less than it in the flight predicts at the
+/// start only if it may meet something along its line (`may_meet`); otherwise it joins in when
+/// a collision changes its flight. The events are the same as when everyone predicts.
+pub(crate) fn run<V: Vector>(
+    w: &mut State<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    t_end: f64,
+    slow_below: Option<f64>,
+    keep: bool,
+    stats: &mut StepStats,
+) -> Result<Option<f64>, Error> {
+    sc.slow_below = slow_below;
+    sc.outgrown = false;
+    let step = w.step_count;
+    // Kept only for straight flights in which everyone predicts (a curved prediction would have
+    // to look steps ahead; a slow critter that predicts nothing would miss later steps' events).
+    let keep = keep && slow_below.is_none() && acc.length_squared() == 0.0;
+    #[cfg(test)]
+    let keep = keep && !sc.no_keep;
+    let kept = sc
+        .kept
+        .take()
+        .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
+    let life = steps_to_live(keep, step);
+    let out = match kept {
+        Some(_) => match take_up_kept(w, sc, t_end, step) {
+            Ok(true) => fly_kept(w, sc, acc, t_end, stats),
+            Ok(false) => {
+                sc.churned_at = Some(step);
+                fly_new(w, sc, acc, t_end, life, stats)
+            }
+            Err(e) => Err(e),
+        },
+        None => fly_new(w, sc, acc, t_end, life, stats),
+    };
+    if keep && !sc.outgrown && matches!(out, Ok(None)) && !(step + 1).is_multiple_of(FLIGHT_STEPS) {
+        sc.kept = Some(KeptFlight {
+            step: step + 1,
+            dt: t_end,
+        });
+    } else {
+        sc.kept = None;
+        sc.queue.reset(0, 0.0, 0.0);
+    }
+    out
+}
+
+/// Flies the critters to `t_end` in new flights: one, unless a hook grows a critter beyond the
+/// largest radius the flight's cells (or shells) were sized for: the flight then stops there,
+/// everyone is brought to that time, and a new flight, sized for the grown critter, flies the
+/// rest.
+fn fly_new<V: Vector>(
+    w: &mut State<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    t_end: f64,
+    life: u64,
+    stats: &mut StepStats,
+) -> Result<Option<f64>, Error> {
+    sc.grown_radius = 0.0;
+    let (mut flown, mut virial) = (0.0, 0.0);
+    loop {
+        // A flight set up again after a critter grew lives to the step's end only.
+        let life = if flown == 0.0 { life } else { 1 };
+        let outcome = fly(w, sc, acc, None, t_end - flown, life, stats);
+        virial += sc.virial;
+        sc.virial = virial;
+        match outcome? {
+            FlightEnd::Done(stopped) => return Ok(stopped.map(|t| flown + t)),
+            FlightEnd::Grown(t) => {
+                sc.outgrown = true;
+                flown += t
+            }
+        }
+    }
+}
+
+/// How a flight ended.
+enum FlightEnd {
+    /// At its end, or where the event budget ran out (the time everyone is at).
+    Done(Option<f64>),
+    /// At this time, because a hook grew a critter beyond what the cells were sized for.
+    Grown(f64),
+}
+
+/// Flies for `span` from flight time `from` (a kept flight that `take_up_kept` took up), or
+/// sets up a new flight whose predictions look `life` steps of `span` ahead and flies it from 0.
+fn fly<V: Vector>(
+    w: &mut State<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    from: Option<f64>,
+    span: f64,
+    life: u64,
+    stats: &mut StepStats,
+) -> Result<FlightEnd, Error> {
+    let n = w.critters.slot_count() as u32;
+    let start = match from {
+        Some(t) => t,
+        None => {
+            // A little past the life's last step's end, whatever the rounding of the steps'
+            // sums of dt.
+            let horizon = if life > 1 {
+                span * life as f64 * (1.0 + ROUNDING_MARGIN)
+            } else {
+                span
+            };
+            setup(w, sc, acc, span, horizon);
+            match sc.slow_below {
+                Some(limit) => {
+                    mark_who_may_meet(w, sc);
+                    for a in 0..n {
+                        if sc.reach[a as usize] > limit || sc.meets[a as usize] {
+                            predict(w, sc, a, 0.0)?;
+                        }
+                    }
+                }
+                None => {
+                    for a in 0..n {
+                        predict(w, sc, a, 0.0)?;
+                    }
+                }
+            }
+            0.0
+        }
+    };
+    let t_end = start + span; // (exactly `span` for a new flight, which starts at 0)
+    let mut processed = 0u64;
+    let mut stopped = None;
+    let mut grown = None;
+    // Every branch below predicts the event's owner again (which replaces the event in the
+    // queue) or removes the event.
+    while let Some(ev) = sc.queue.peek_until(t_end) {
+        if ev.time > t_end {
+            break;
+        }
+        match validity(sc, &ev) {
+            Validity::Stale => {
+                sc.queue.remove(ev.owner);
+                continue;
+            }
+            Validity::PartnerChanged => {
+                predict(w, sc, ev.owner, ev.time)?;
+                continue;
+            }
+            Validity::Valid => {}
+        }
+        processed += 1;
+        if processed > sc.budget {
+            stopped = Some(ev.time);
+            break;
+        }
+        let t = ev.time;
+        if sc.shells {
+            // What the predictions after this event read: the bodies of both critters'
+            // neighbours, asked for before the collision's own work; and what the next event
+            // most likely reads (a large gas's loads are scattered). Not with cells: there it
+            // costs 2D gases time.
+            for x in [ev.owner, ev.other] {
+                if ev.kind == EventKind::Pair || x == ev.owner {
+                    for &p in sc.neighbours.members(x as usize) {
+                        crate::prefetch::prefetch(sc.body.get(p as usize));
+                    }
+                }
+            }
+            if let Some(next) = sc.queue.runner_up() {
+                prefetch_event(w, sc, &next);
+            }
+        }
+        let (a, b) = (ev.owner, ev.other);
+        match ev.kind {
+            EventKind::Pair | EventKind::Wall => {
+                advance(w, sc, a, t);
+                advance(w, sc, b, t);
+                stats.contacts += 1;
+                let deaths = w.pending.deaths.len();
+                if collide(w, sc, a, b, t)? {
+                    stats.collisions += 1;
+                }
+                // A hook may kill third critters: their bodies must know.
+                for i in deaths..w.pending.deaths.len() {
+                    let x = w.pending.deaths[i].index;
+                    refresh_body(w, sc, x);
+                }
+                if let (Some(x), Some(y)) = (w.critters.slot(a), w.critters.slot(b)) {
+                    if x.alive && y.alive {
+                        if let Some(c) = crate::response::contact_between(&w.topo, x, y) {
+                            if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {
+                                sc.stuck.insert(pair_key(a, b));
+                            }
+                        }
+                    }
+                }
+                sc.last_partner[a as usize] = b;
+                sc.last_collision[a as usize] = t;
+                if ev.kind == EventKind::Pair {
+                    sc.last_partner[b as usize] = a;
+                    sc.last_collision[b as usize] = t;
+                }
+                for x in [a, b] {
+                    if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
+                        let s = &mut sc.status[x as usize];
+                        s.changes = s.changes.wrapping_add(1);
+                        relocate(w, sc, x);
+                        refresh_body(w, sc, x);
+                    }
+                }
+                // A radius (NaN for walls and the dead) beyond what the cells were sized for:
+                // neighbours it now reaches may lie outside the cells it scans. Cells sized for
+                // twice the new radius make many restarts in one flight unlikely.
+                let radius = |x: u32| sc.body[x as usize].radius;
+                let largest = radius(a).max(radius(b));
+                if largest > sc.largest_radius {
+                    sc.grown_radius = 2.0 * largest;
+                    grown = Some(t);
+                    break;
+                }
+                for x in [a, b] {
+                    predict(w, sc, x, t)?;
+                }
+            }
+            EventKind::Border => {
+                advance(w, sc, a, t);
+                bounce_border(w, a, b);
+                refresh_body(w, sc, a);
+                sc.last_partner[a as usize] = BORDER_PARTNER + b;
+                let s = &mut sc.status[a as usize];
+                s.changes = s.changes.wrapping_add(1);
+                predict(w, sc, a, t)?;
+            }
+            EventKind::CellCrossing => {
+                cross_cell(w, sc, a, b, t);
+                refresh_body(w, sc, a);
+                predict_after_crossing(w, sc, a, b, t)?;
+            }
+            EventKind::ShellExit => {
+                advance(w, sc, a, t);
+                relist(w, sc, a);
+                predict(w, sc, a, t)?;
+            }
+            EventKind::Recheck => {
+                // Continue a curved prediction that did not settle.
+                predict(w, sc, a, t)?;
+            }
+        }
+    }
+    stats.events += processed.min(sc.budget);
+    stats.pair_tests += sc.pair_tests;
+    stats.candidates += sc.predictions as usize;
+    // Everyone to the end of the flight.
+    let end = grown.or(stopped).unwrap_or(t_end);
+    sc.ended_at = end;
+    let topo = w.topo;
+    for a in 0..n {
+        advance(w, sc, a, end);
+        if let Some(c) = w.critters.slot_mut_moving(a) {
+            if c.alive && !c.is_wall() {
+                c.pos = if topo.wraps() {
+                    topo.wrap_position(c.pos)
+                } else {
+                    topo.apply(c.pos, c.vel, c.radius, c.restitution()).0
+                };
+            }
+        }
+    }
+    Ok(match grown {
+        Some(t) => FlightEnd::Grown(t - start),
+        None => FlightEnd::Done(stopped.map(|t| t - start)),
+    })
+}
+
+/// Hands a touching pair to the caller's `collide` hook (Pop's roles), with the TC model.
+fn collide<V: Vector>(
+    w: &mut State<V>,
+    sc: &mut Scratch<V>,
+    a: u32,
+    b: u32,
+    t: f64,
+) -> Result<bool, Error> {
+    let (ca, cb) = (
+        w.critters.slot(a).expect("live"),
+        w.critters.slot(b).expect("live"),
+    );
+    let rule = match w
+        .rules
+        .rule(&w.kinds, &w.topo, ca, cb)
+        .map_err(|e| at_step(e, w.step_count))?
+    {
+        Some(r) => r,
+        None => crate::rules::roles_of(&w.kinds, &w.topo, ca, cb)
+            .map_err(|e| at_step(e, w.step_count))?,
+    };
+    let Some((caller, arg)) = roles_order(rule, ca, cb) else {
+        return Ok(false);
+    };
+    let (caller, arg) = (caller.id.index, arg.id.index);
+    // TC model: a collision right after another one of either critter is elastic.
+    let recent = |x: u32| t - sc.last_collision[x as usize] < sc.tc_window;
+    let tc = recent(a) || (!cb.is_wall() && recent(b));
+    let saved = if tc {
+        let e = [a, b].map(|x| w.critters.slot(x).map_or(1.0, |c| c.restitution()));
+        for x in [a, b] {
+            if let Some(c) = w.critters.slot_mut(x) {
+                c.traits_mut().restitution = 1.0;
+            }
+        }
+        Some(e)
+    } else {
+        None
+    };
+    let before = w.events.collisions.len();
+    let out = w.collide_pair(caller, arg);
+    if let Some(e) = saved {
+        for (x, e) in [a, b].into_iter().zip(e) {
+            if let Some(c) = w.critters.slot_mut(x) {
+                if c.restitution() == 1.0 {
+                    c.traits_mut().restitution = e;
+                }
+            }
+        }
+    }
+    for ev in &w.events.collisions[before..] {
+        let (Some(c1), Some(c2)) = (w.critters.get(ev.caller), w.critters.get(ev.arg)) else {
+            continue;
+        };
+        if !c1.is_wall() && !c2.is_wall() {
+            sc.virial += (c1.radius + c2.radius) * ev.impulse;
+        }
+    }
+    out
+}
