@@ -22,7 +22,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use critterbox::glam::DVec2;
 use critterbox::scenes::{gas, GasParams};
-use critterbox::wall::DEFAULT_WALL_THICKNESS;
+use critterbox::DEFAULT_WALL_THICKNESS;
 use critterbox::{BroadPhaseMode, CritterSpec, Method, Rng, WallBox, World, WorldConfig};
 use std::f64::consts::PI;
 use std::time::Duration;

@@ -20,7 +20,7 @@ use std::sync::Arc;
 ///
 /// Every mutable accessor marks the critters as possibly changed in any field, so the next
 /// state hash reads them whole; the engine's own `*_moving` accessors, which write positions,
-/// velocities and rule classes only, do not (see [`Statics`]).
+/// velocities and rule classes only, do not (see `hash::critters::Statics`).
 #[derive(Clone, Debug)]
 pub struct CritterSet<V: Vector> {
     /// The critters by slot.
@@ -46,7 +46,7 @@ const NO_SLOT: u32 = u32::MAX;
 /// (empty when every critter's slot is its id's index). The state hash and totals go through
 /// this, so they do not depend on where the critters are stored.
 #[derive(Clone, Copy, Debug)]
-pub struct InIdOrder<'a, V: Vector> {
+pub(crate) struct InIdOrder<'a, V: Vector> {
     /// The critters by slot.
     pub slots: &'a [Option<Critter<V>>],
     /// By id index, the slot ([`u32::MAX`] for none); empty for slot = id index.
@@ -67,11 +67,6 @@ impl<'a, V: Vector> InIdOrder<'a, V> {
         } else {
             self.place.len()
         }
-    }
-
-    /// True when there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     /// The critter of id index `i`.
@@ -189,7 +184,7 @@ impl<V: Vector> CritterSet<V> {
     }
 
     /// The critters seen in id order (see [`InIdOrder`]).
-    pub fn in_id_order(&self) -> InIdOrder<'_, V> {
+    pub(crate) fn in_id_order(&self) -> InIdOrder<'_, V> {
         InIdOrder {
             slots: &self.slots,
             place: &self.place,

@@ -184,8 +184,6 @@ pub struct KindSet<V: Vector> {
     by_name: BTreeMap<String, KindId>,
 }
 
-/// The kind id of `ball` in every world.
-pub const BALL: KindId = KindId(0);
 /// The kind id of `wall` in every world.
 pub const WALL: KindId = KindId(1);
 

@@ -21,49 +21,59 @@
 //! See `docs/ARCHITECTURE.md` for a map of the modules.
 
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 
-pub mod border;
-pub mod broad_phase;
-pub mod contact;
-pub mod context;
-pub mod critter;
-pub mod critter_set;
-pub mod error;
-pub mod hash;
-pub mod kind;
-pub mod method;
+// The engine's parts, reached through the re-exports below.
+mod border;
+mod contact;
+mod context;
+mod critter;
+mod critter_set;
+mod error;
+mod hash;
+mod kind;
 mod pairs;
 mod parallel;
 mod prefetch;
+mod response;
+mod rng;
+mod rules;
+mod vector;
+mod wall;
+
+// The broad phase on its own, for its tests and benches.
+#[doc(hidden)]
+pub mod broad_phase;
+
+pub mod method;
 pub mod recording;
-pub mod response;
-pub mod rng;
-pub mod rules;
 pub mod scenes;
 pub mod script;
 pub mod testing;
-pub mod vector;
 #[cfg(feature = "rerun")]
 pub mod viewer;
-pub mod wall;
 pub mod world;
 
 pub use border::{Border, Topology};
 pub use broad_phase::BroadPhaseMode;
-pub use context::{CollideCtx, CollisionEvent, StepEvents, UpdateCtx};
+pub use context::{Access, CollideCtx, CollisionEvent, StepEvents, UpdateCtx};
 pub use critter::{
-    Critter, CritterId, CritterSpec, PropValue, Props, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
+    Critter, CritterId, CritterSpec, PropValue, Props, Shape, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
     CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
 };
 pub use critter_set::CritterSet;
 pub use error::{Error, ScriptError};
 pub use glam;
 pub use kind::{
-    default_collides_with, CollideRule, KindDefaults, KindHooks, KindId, KindSet, RuleCtx,
+    default_collides_with, CollideRule, Kind, KindDefaults, KindHooks, KindId, KindSet, RuleCtx,
 };
 pub use method::Method;
 pub use parallel::PARALLEL_MIN;
+pub use response::Hit;
 pub use rng::Rng;
+pub use rules::RuleCache;
+#[doc(hidden)]
+pub use vector::Align64;
 pub use vector::Vector;
-pub use wall::WallBox;
+pub use wall::{ClosestFeature, WallBox, DEFAULT_WALL_THICKNESS};
 pub use world::{Diagnostics, Locality, StepStats, World, WorldConfig};

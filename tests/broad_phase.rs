@@ -5,10 +5,10 @@
 
 mod common;
 
-use critterbox::border::Topology;
 use critterbox::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode};
 use critterbox::glam::{DVec2, DVec3};
 use critterbox::scenes::{gas, GasParams};
+use critterbox::Topology;
 use critterbox::{Border, Rng, Vector, World};
 use std::collections::BTreeSet;
 

@@ -81,7 +81,7 @@ fn a_large_2d_gas_under_solve_is_bit_identical_on_one_and_two_threads() {
 /// and wake their islands. The same bits on one and two threads.
 #[test]
 fn a_large_sleeping_layer_is_bit_identical_on_one_and_two_threads() {
-    use critterbox::wall::WallBox;
+    use critterbox::WallBox;
     use critterbox::{CritterSpec, Method, World, WorldConfig};
     let n = PARALLEL_MIN + 500;
     let run = || {

@@ -8,7 +8,7 @@ use common::*;
 use critterbox::glam::DVec2;
 use critterbox::method::sleep::{SLEEP_SPEED_STEPS, SLEEP_STEPS};
 use critterbox::scenes::{gas, GasParams};
-use critterbox::wall::WallBox;
+use critterbox::WallBox;
 use critterbox::{CritterId, CritterSpec, Method, World, WorldConfig};
 
 const R: f64 = 0.5;
@@ -285,10 +285,10 @@ fn a_scene_turns_sleep_off_with_its_world_setting() {
 /// A kind whose own `collide` only counts its calls.
 struct Counting(std::rc::Rc<std::cell::Cell<u32>>);
 
-impl critterbox::kind::KindHooks<DVec2> for Counting {
+impl critterbox::KindHooks<DVec2> for Counting {
     fn collide(
         &self,
-        _ctx: &mut critterbox::context::CollideCtx<'_, DVec2>,
+        _ctx: &mut critterbox::CollideCtx<'_, DVec2>,
     ) -> Result<bool, critterbox::Error> {
         self.0.set(self.0.get() + 1);
         Ok(true)
@@ -297,7 +297,7 @@ impl critterbox::kind::KindHooks<DVec2> for Counting {
 
 #[test]
 fn a_collide_hook_that_takes_a_sleeper_wakes_its_island() {
-    use critterbox::kind::KindDefaults;
+    use critterbox::KindDefaults;
     let (mut w, ids) = pile(20, true);
     let calls = std::rc::Rc::new(std::cell::Cell::new(0));
     let defaults = KindDefaults {

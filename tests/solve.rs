@@ -5,15 +5,15 @@
 mod common;
 
 use common::*;
-use critterbox::context::CollideCtx;
 use critterbox::glam::DVec2;
-use critterbox::kind::{KindDefaults, KindHooks};
 use critterbox::method::auto::{AUTO_MOST_SWEEPS, AUTO_SWEEPS};
 use critterbox::method::solve::LAYERS_PER_SWEEP;
 use critterbox::scenes::stress::pile;
 use critterbox::scenes::{gas, GasParams};
-use critterbox::wall::WallBox;
+use critterbox::CollideCtx;
+use critterbox::WallBox;
 use critterbox::{Border, CritterSpec, Error, Method, World, WorldConfig};
+use critterbox::{KindDefaults, KindHooks};
 use std::rc::Rc;
 
 fn open_world(method: Method, gravity: DVec2) -> World<DVec2> {

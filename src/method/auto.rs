@@ -12,7 +12,7 @@
 //! * **Without gravity** nothing rests, and a solve would spread a Newton's cradle's momentum
 //!   over its balls, so the step is never solved. It is `event`, exact, with its flight kept
 //!   from step to step so that a step pays for its events, not for predicting everyone anew.
-//!   The one exception is a slow step (no critter moves more than [`SWEEP_FRACTION`] of the
+//!   The one exception is a slow step (no critter moves more than `SWEEP_FRACTION` of the
 //!   smallest radius or wall thickness) in a scene where something outside the flight (hooks
 //!   steering critters, critters coming and going) changed more than
 //!   `flight::CHURN` of the critters since the last step: a kept flight would
@@ -111,7 +111,7 @@ pub enum Why {
         fastest: f64,
         /// The smallest radius or wall thickness.
         smallest: f64,
-        /// Disks that move more than [`SWEEP_FRACTION`] of `smallest`.
+        /// Disks that move more than `SWEEP_FRACTION` of `smallest`.
         fast: usize,
         /// All disks.
         all: usize,

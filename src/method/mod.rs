@@ -2,9 +2,9 @@
 //!
 //! * [`Method::Discrete`]: Pop's move, find overlaps, respond, separate (`World::step`'s stages).
 //! * [`Method::Substep`]: the same with `n` substeps of `dt / n` (update hooks once per step).
-//! * [`Method::Swept`]: continuous collision detection within the step ([`swept`]): times of
+//! * [`Method::Swept`]: continuous collision detection within the step (`swept`): times of
 //!   impact resolved in time order, then a discrete pass for resting contacts. No tunnelling.
-//! * [`Method::Event`]: exact event-driven dynamics ([`event`]): parabolic flights under gravity,
+//! * [`Method::Event`]: exact event-driven dynamics (`event`): parabolic flights under gravity,
 //!   collisions, wall hits, border and cell crossings processed in time order.
 //! * [`Method::Solve`]: the discrete step with its contacts solved together ([`solve`]): `n`
 //!   sweeps of sequential impulses over every contact, then a partial position correction, so
@@ -19,13 +19,13 @@
 
 pub mod auto;
 pub(crate) mod discrete;
-pub mod event;
+pub(crate) mod event;
 pub(crate) mod flight;
 mod queue;
 pub mod sleep;
 pub mod solve;
 pub(crate) mod state;
-pub mod swept;
+pub(crate) mod swept;
 pub mod toi;
 
 pub use flight::FLIGHT_STEPS;

@@ -251,7 +251,7 @@ impl<V: Vector> World<V> {
         self.methods.collision_virial()
     }
     /// Total kinetic energy of the free critters, in four interleaved sums over the slots added
-    /// in order ([`crate::hash::critters::totals`]: the recording's totals have the same bits).
+    /// in order, the same sums as the recording's totals (so they have the same bits).
     pub fn kinetic_energy(&self) -> f64 {
         crate::hash::critters::totals(self.state.critters.in_id_order()).0
     }

@@ -3,12 +3,12 @@
 //! the bullet sweep behind the table's first row.
 
 use clap::Args;
-use critterbox::error::Error;
 use critterbox::method::Method;
 use critterbox::scenes::stress::{
     bullet, bullet_3d, bullet_speeds, first_tunnelling_speed, first_tunnelling_speed_3d, Stress,
     METHODS, STRESS, STRESS_3D,
 };
+use critterbox::Error;
 use std::io::Write;
 use std::time::Instant;
 

@@ -64,7 +64,7 @@ struct Lent<'a, W>(&'a mut W);
 unsafe impl<W> Send for Lent<'_, W> {}
 
 /// Milliseconds per step of `steps` steps of `world` on `pool`'s threads.
-fn time_on<V: critterbox::vector::Vector>(
+fn time_on<V: critterbox::Vector>(
     pool: &rayon::ThreadPool,
     world: &mut critterbox::World<V>,
     steps: usize,

@@ -14,19 +14,21 @@
 //! [`values`] converts between script values and the engine's, and [`spawn`] turns spawn maps
 //! into spawns; both serve the capabilities above.
 
+pub(crate) mod checks;
 mod critter;
 mod kind_decl;
 mod random;
 mod rules;
 mod scene;
 mod spawn;
+mod test_only;
 mod values;
 mod vec;
 mod world;
 
 pub(crate) use critter::CritterRef;
 pub(crate) use rules::{rule_code, rule_of_code};
-pub(crate) use values::{num, num_or, props_from_map};
+pub(crate) use values::{num_or, props_from_map};
 pub(crate) use world::WorldRef;
 
 use super::host::Host;
@@ -90,8 +92,10 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     random::register(&mut engine, host);
     kind_decl::register(&mut engine, host);
     scene::register(&mut engine, host);
-    if let Some(extension) = host.extension.clone() {
-        extension.register(&mut engine, host);
+    checks::register(&mut engine, host);
+    match host.extension.clone() {
+        Some(extension) => extension.register(&mut engine, host),
+        None => test_only::register(&mut engine),
     }
     engine
 }
