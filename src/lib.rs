@@ -38,6 +38,7 @@ mod prefetch;
 mod response;
 mod rng;
 mod rules;
+mod tolerance;
 mod vector;
 mod wall;
 

@@ -1,6 +1,7 @@
 //! Wall geometry: an immovable oriented box (Pop's cCritterWall): length x thickness in 2D, a box in 3D.
 
 use crate::error::Error;
+use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
 use glam::{DMat3, DVec2, DVec3};
 
@@ -72,7 +73,7 @@ impl<V: Vector> WallBox<V> {
             for other in 0..V::DIM {
                 let d = V::frame_axis(&self.frame, axis).dot(V::frame_axis(&self.frame, other));
                 let want = if axis == other { 1.0 } else { 0.0 };
-                let orthonormal = (d - want).abs() < 1e-9; // false for NaN too
+                let orthonormal = (d - want).abs() < ROUNDING_MARGIN; // false for NaN too
                 if !orthonormal {
                     return Err(bad(
                         "orientation",

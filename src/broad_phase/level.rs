@@ -4,6 +4,7 @@
 use super::cell_box::{cells_overlap_flag, CellBox};
 use super::BroadObject;
 use crate::border::Topology;
+use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
 
 /// At most this many parts of a large level's counting sort run at once (each reads every
@@ -160,7 +161,7 @@ impl<V: Vector> Level<V> {
             // round, and a member on the footprint's edge may touch `b` exactly: a billionth
             // more keeps it in.
             let reach = half.get(axis) + 0.5 / self.inv_cell[axis];
-            let margin = reach + 1e-9 * ((center.get(axis) - origin).abs() + reach);
+            let margin = reach + ROUNDING_MARGIN * ((center.get(axis) - origin).abs() + reach);
             let cell_of = |x: f64| floor_to_i64((x - origin) * self.inv_cell[axis]);
             let (first, last) = (
                 cell_of(center.get(axis) - margin),

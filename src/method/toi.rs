@@ -6,6 +6,7 @@
 //! moving on a line and a convex set is convex in time, so a separating pair never comes back).
 
 use crate::contact::contact_wall_ball;
+use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
 use crate::wall::WallBox;
 
@@ -22,8 +23,8 @@ pub fn toi_ball_ball<V: Vector>(d: V, w: V, r_sum: f64) -> Option<f64> {
 /// the early test cannot be trusted) exactly `toi_ball_ball`'s answer.
 ///
 /// The discriminant is at most `b^2`, so the smaller root `c / (-b + sqrt(disc))` is at least
-/// `c / (-2b)`. The test asks for `c > -2b horizon (1 + 1e-9)`: the computed root is then within
-/// a few units in the last place of a value at least `horizon (1 + 1e-9)`, so it is above
+/// `c / (-2b)`. The test asks for `c > -2b horizon (1 + ROUNDING_MARGIN)`: the computed root is then within
+/// a few units in the last place of a value at least `horizon (1 + ROUNDING_MARGIN)`, so it is above
 /// `horizon` too, and a caller that drops roots beyond `horizon` drops the same pairs. It is
 /// skipped when `-2b horizon` is not a normal number (zero, subnormal, NaN, infinite).
 #[inline]
@@ -37,7 +38,7 @@ pub fn toi_ball_ball_by<V: Vector>(d: V, w: V, r_sum: f64, horizon: f64) -> Opti
         return Some(0.0);
     }
     let bound = -2.0 * b * horizon;
-    if bound.is_normal() && c > bound * (1.0 + 1e-9) {
+    if bound.is_normal() && c > bound * (1.0 + ROUNDING_MARGIN) {
         return None;
     }
     let a = w.length_squared();
@@ -59,7 +60,7 @@ pub fn surely_no_toi_by<V: Vector>(d: V, w: V, r_sum: f64, horizon: f64) -> bool
     let (b, dd) = (d.dot(w), d.length_squared());
     let c = dd - r_sum * r_sum;
     let bound = -2.0 * b * horizon;
-    let later = (b >= 0.0) | (bound.is_normal() & (c > bound * (1.0 + 1e-9)));
+    let later = (b >= 0.0) | (bound.is_normal() & (c > bound * (1.0 + ROUNDING_MARGIN)));
     later & (dd >= r_sum * r_sum)
 }
 

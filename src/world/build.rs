@@ -10,6 +10,7 @@ use crate::critter::{
 };
 use crate::error::Error;
 use crate::kind::{KindDefaults, KindHooks, KindId, WALL};
+use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
 use crate::wall::WallBox;
 use std::rc::Rc;
@@ -186,7 +187,7 @@ impl<V: Vector> State<V> {
             };
             let d = self.topo.delta(wall.pos, spec.pos);
             if let Some(c) = contact_wall_ball(geom, d, radius) {
-                if c.depth > 1e-9 * radius.max(1.0) {
+                if c.depth > ROUNDING_MARGIN * radius.max(1.0) {
                     return Err(Error::SpawnInsideWall {
                         critter: who(),
                         wall: wall_id,

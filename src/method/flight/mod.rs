@@ -85,9 +85,7 @@ pub const BUDGET_PER_CRITTER: u64 = 64;
 /// left more often, thicker ones list more partners (`docs/methods.md` has the trade).
 pub const SHELL_FRACTION: f64 = 0.6;
 
-/// A relative margin far above the rounding of a few operations on f64s, for bounds that must
-/// hold whatever the rounding.
-const ROUNDING_MARGIN: f64 = 1e-9;
+pub(crate) use crate::tolerance::ROUNDING_MARGIN;
 
 /// An unset slot, cell or partner (above every slot).
 const UNSET: u32 = u32::MAX;
