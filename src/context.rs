@@ -4,10 +4,12 @@
 use crate::border::Topology;
 use crate::critter::{Critter, CritterId, CritterSpec};
 use crate::critter_set::CritterSet;
+use crate::error::{Error, ScriptError};
 use crate::kind::{KindId, KindSet};
 use crate::response::{self, Hit};
 use crate::rng::Rng;
 use crate::vector::Vector;
+use crate::world::OnOverlap;
 use std::ops::{Deref, DerefMut};
 
 /// A collision that happened in a step.
@@ -53,8 +55,64 @@ impl<V> StepEvents<V> {
 /// Spawns waiting for the end of the step.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Pending<V: Vector> {
-    pub spawns: Vec<CritterSpec<V>>,
+    pub spawns: Vec<PendingSpawn<V>>,
     pub deaths: Vec<CritterId>,
+}
+
+/// A spawn queued by a hook: what to add, how to place it, and where it was asked for.
+#[derive(Clone, Debug)]
+pub(crate) struct PendingSpawn<V: Vector> {
+    pub spec: CritterSpec<V>,
+    pub on_overlap: OnOverlap,
+    /// `None` for a spawn from Rust (`Access::spawn`).
+    pub origin: Option<Box<SpawnOrigin>>,
+}
+
+/// Where a queued spawn was asked for, so that its failure at the end of the step names the
+/// script's file:line:col, the hook's kind, the hook, the critter and the step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct SpawnOrigin {
+    pub file: String,
+    pub line: Option<usize>,
+    pub column: Option<usize>,
+    pub kind: Option<String>,
+    pub hook: Option<String>,
+    pub critter: Option<CritterId>,
+    pub step: u64,
+}
+
+impl SpawnOrigin {
+    /// `file:line:col` of the `spawn` call.
+    pub fn place(&self) -> String {
+        match (self.line, self.column) {
+            (Some(l), Some(c)) => format!("{}:{l}:{c}", self.file),
+            (Some(l), None) => format!("{}:{l}", self.file),
+            _ => self.file.clone(),
+        }
+    }
+
+    /// `e`, the failure of the spawn asked for here, located at the `spawn` call.
+    pub fn locate(&self, e: Error) -> Error {
+        let inside_wall = matches!(e, Error::SpawnInsideWall { .. });
+        let message = match e {
+            Error::Script(s) => s.message,
+            other => other.to_string(),
+        };
+        let mut err = ScriptError::new(&self.file, format!("spawn failed: {message}"));
+        err.line = self.line;
+        err.column = self.column;
+        err.kind = self.kind.clone();
+        err.hook = self.hook.clone();
+        err.critter = self.critter;
+        err.step = Some(self.step);
+        if inside_wall {
+            err.hint = Some(
+                "add on_overlap: \"push\" (moved out) or \"skip\" (not added) to the spawn map"
+                    .into(),
+            );
+        }
+        Error::from(err)
+    }
 }
 
 /// Read-write access to the world from inside a hook.
@@ -142,7 +200,20 @@ impl<V: Vector> Access<'_, V> {
     }
     /// Queues a spawn for the end of the step (checked then, like any spawn).
     pub fn spawn(&mut self, spec: CritterSpec<V>) {
-        self.pending.spawns.push(spec);
+        self.spawn_placed(spec, OnOverlap::Error, None);
+    }
+    /// Queues a spawn placed under `on_overlap`, remembering where a script asked for it.
+    pub(crate) fn spawn_placed(
+        &mut self,
+        spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+        origin: Option<Box<SpawnOrigin>>,
+    ) {
+        self.pending.spawns.push(PendingSpawn {
+            spec,
+            on_overlap,
+            origin,
+        });
     }
     /// Adds a line to the step's log.
     pub fn log(&mut self, line: impl Into<String>) {

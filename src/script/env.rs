@@ -3,13 +3,13 @@
 //! read-only view `collides_with` gets is in [`super::kind`].
 
 use crate::border::Topology;
-use crate::context::Access;
+use crate::context::{Access, SpawnOrigin};
 use crate::critter::{Critter, CritterId, CritterSpec};
 use crate::error::Error;
 use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
 use crate::vector::Vector;
-use crate::world::World;
+use crate::world::{OnOverlap, Placed, World};
 
 /// What a script may do to the world it runs in.
 pub(crate) trait Env<V: Vector> {
@@ -25,6 +25,22 @@ pub(crate) trait Env<V: Vector> {
     fn damage(&mut self, id: CritterId, amount: f64);
     /// Spawns now (`Some(id)`) between steps, or queues for the end of the step (`None`).
     fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error>;
+    /// Spawns placed under `on_overlap`: now between steps (`Some`), or queued for the end of
+    /// the step with where a script asked for it (`None`).
+    fn spawn_placed(
+        &mut self,
+        spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+        _origin: Option<Box<SpawnOrigin>>,
+    ) -> Result<Option<Placed>, Error> {
+        if on_overlap == OnOverlap::Error {
+            return Ok(self.spawn(spec)?.map(Placed::Added));
+        }
+        Err(Error::InvalidKind {
+            kind: spec.kind,
+            reason: "on_overlap is for spawns in a scene, a test or a hook".into(),
+        })
+    }
     fn log(&mut self, line: String);
     fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
     fn touches(&self, a: CritterId, b: CritterId) -> bool {
@@ -93,6 +109,14 @@ impl<V: Vector> Env<V> for World<V> {
     fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
         World::spawn(self, spec).map(Some)
     }
+    fn spawn_placed(
+        &mut self,
+        spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+        _origin: Option<Box<SpawnOrigin>>,
+    ) -> Result<Option<Placed>, Error> {
+        World::spawn_placed(self, spec, on_overlap).map(Some)
+    }
     fn log(&mut self, line: String) {
         self.log_line(line);
     }
@@ -144,6 +168,15 @@ impl<V: Vector> Env<V> for Access<'_, V> {
     }
     fn spawn(&mut self, spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
         Access::spawn(self, spec);
+        Ok(None)
+    }
+    fn spawn_placed(
+        &mut self,
+        spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+        origin: Option<Box<SpawnOrigin>>,
+    ) -> Result<Option<Placed>, Error> {
+        Access::spawn_placed(self, spec, on_overlap, origin);
         Ok(None)
     }
     fn log(&mut self, line: String) {

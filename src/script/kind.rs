@@ -331,9 +331,11 @@ pub(crate) fn load_into<V: Dim>(
         def: def.clone(),
         rt: rt.clone(),
     });
-    world
+    let id = world
         .register_kind(&def.name, parent.as_deref(), def.defaults.clone(), hooks)
-        .map_err(|e| in_kind(e, &def.file, &def.name))
+        .map_err(|e| in_kind(e, &def.file, &def.name))?;
+    super::kind_refs::load_named(rt, world, &def.file)?;
+    Ok(id)
 }
 
 /// A script kind as the engine sees it.

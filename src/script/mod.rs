@@ -14,6 +14,8 @@ pub(crate) mod env;
 pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
+pub(crate) mod kind_refs;
+pub(crate) mod lint;
 pub(crate) mod scene;
 
 use crate::error::{Error, ScriptError};
@@ -125,6 +127,39 @@ impl Runtime {
                 limits: options.limits.clone(),
             }
         })
+    }
+
+    /// The file of the kind `name` on the kind search path, if there is one.
+    pub fn resolve_kind(&self, name: &str) -> Option<PathBuf> {
+        self.kind_dirs
+            .iter()
+            .map(|dir| dir.join(format!("{name}.rhai")))
+            .find(|p| p.is_file())
+    }
+
+    /// The names of every kind on the kind search path, and the native ones.
+    pub fn known_kind_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = kind_refs::NATIVE_KINDS
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for dir in &self.kind_dirs {
+            let Ok(entries) = std::fs::read_dir(dir) else {
+                continue;
+            };
+            for entry in entries.flatten() {
+                let path = entry.path();
+                if path.extension().is_some_and(|e| e == "rhai") {
+                    if let Some(stem) = path.file_stem() {
+                        names.push(stem.to_string_lossy().into_owned());
+                    }
+                }
+            }
+        }
+        names.extend(self.kinds.borrow().keys().cloned());
+        names.sort();
+        names.dedup();
+        names
     }
 
     /// Compiles `text` as `path`; errors carry file, line and column.

@@ -1,5 +1,7 @@
 //! Building a world: kinds, walls, spawns and removals, each checked, so a bad spawn is an
-//! error naming the critter and the field, and nothing is added then.
+//! error naming the critter and the field, and nothing is added then. A spawn may also be
+//! *placed* under an [`OnOverlap`] policy: what happens when it would overlap a wall or another
+//! critter (scripts' `on_overlap`).
 
 use super::state::State;
 use super::{fmt_vec, World};
@@ -16,7 +18,56 @@ use crate::wall::WallBox;
 use std::rc::Rc;
 use std::sync::Arc;
 
+/// What a spawn does when the new critter would overlap a wall or another critter.
+///
+/// A critter *reaches into* a wall when the wall's contact with it is deeper than the rounding
+/// margin, and *overlaps* a live critter when their disks overlap by more than that margin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum OnOverlap {
+    /// Reaching into a wall is an error (the spawn checks as it always did); overlapping
+    /// critters is allowed, as the response separates them.
+    Error,
+    /// Not added if it reaches into a wall or overlaps a critter.
+    Skip,
+    /// Moved out of what it reaches into, deepest first, along each contact normal (at most
+    /// [`MAX_PUSHES`] moves, kept inside the world box); not added if it still overlaps then.
+    Push,
+}
+
+/// Moves `OnOverlap::Push` makes before it gives up.
+pub(crate) const MAX_PUSHES: usize = 16;
+
+impl OnOverlap {
+    /// The policy named `name` (`"error"`, `"skip"`, `"push"`).
+    pub fn parse(name: &str) -> Option<OnOverlap> {
+        match name {
+            "error" => Some(OnOverlap::Error),
+            "skip" => Some(OnOverlap::Skip),
+            "push" => Some(OnOverlap::Push),
+            _ => None,
+        }
+    }
+}
+
+/// What became of a spawn placed under a policy.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Placed {
+    /// Added with this id.
+    Added(CritterId),
+    /// Not added; why, in words.
+    Skipped(String),
+}
+
 impl<V: Vector> World<V> {
+    /// Spawns a critter now, placed under `on_overlap`.
+    pub(crate) fn spawn_placed(
+        &mut self,
+        spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+    ) -> Result<Placed, Error> {
+        self.state.spawn_placed(spec, on_overlap)
+    }
+
     /// Registers a kind (see [`crate::KindSet::register`]).
     pub fn register_kind(
         &mut self,
@@ -65,6 +116,13 @@ impl<V: Vector> World<V> {
     }
 }
 
+/// An overlap found when placing a spawn: with what, and the way out.
+struct Overlap<V> {
+    what: String,
+    normal: V,
+    depth: f64,
+}
+
 impl<V: Vector> State<V> {
     /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
     pub(crate) fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
@@ -104,6 +162,105 @@ impl<V: Vector> State<V> {
             self.run_init(id)?;
         }
         Ok(id)
+    }
+
+    /// Spawns a critter now, placed under `on_overlap` (see [`OnOverlap`]).
+    pub(crate) fn spawn_placed(
+        &mut self,
+        mut spec: CritterSpec<V>,
+        on_overlap: OnOverlap,
+    ) -> Result<Placed, Error> {
+        let radius = match self.kinds.id(&spec.kind) {
+            Ok(k) => spec.radius.unwrap_or(self.kinds.get(k).defaults.radius),
+            // Unknown kinds fail in `spawn`, with the usual message.
+            Err(_) => return self.spawn(spec).map(Placed::Added),
+        };
+        let fits = spec.pos.all_finite() && radius.is_finite() && radius > 0.0;
+        match on_overlap {
+            OnOverlap::Error => return self.spawn(spec).map(Placed::Added),
+            _ if !fits => return self.spawn(spec).map(Placed::Added),
+            OnOverlap::Skip => {
+                if let Some(o) = self.deepest_overlap(spec.pos, radius) {
+                    return Ok(Placed::Skipped(format!(
+                        "the {} to spawn at {} overlaps {} by {:.3}",
+                        spec.kind,
+                        fmt_vec(spec.pos),
+                        o.what,
+                        o.depth
+                    )));
+                }
+            }
+            OnOverlap::Push => match self.push_free(spec.pos, radius) {
+                Ok(p) => spec.pos = p,
+                Err(o) => return Ok(Placed::Skipped(format!(
+                    "the {} to spawn at {} still overlaps {} by {:.3} after {MAX_PUSHES} pushes",
+                    spec.kind,
+                    fmt_vec(spec.pos),
+                    o.what,
+                    o.depth
+                ))),
+            },
+        }
+        self.spawn(spec).map(Placed::Added)
+    }
+
+    /// The deepest overlap of a disk of radius `r` at `p` with a wall or a live critter.
+    fn deepest_overlap(&self, p: V, r: f64) -> Option<Overlap<V>> {
+        let margin = ROUNDING_MARGIN * r.max(1.0);
+        let mut deepest: Option<Overlap<V>> = None;
+        let mut consider = |o: Overlap<V>| {
+            if o.depth > margin && deepest.as_ref().is_none_or(|d| o.depth > d.depth) {
+                deepest = Some(o);
+            }
+        };
+        for c in self.critters.iter() {
+            if !c.alive {
+                continue;
+            }
+            let d = self.topo.delta(c.pos, p);
+            match c.shape() {
+                Shape::Wall(geom) => {
+                    if let Some(hit) = contact_wall_ball(geom, d, r) {
+                        consider(Overlap {
+                            what: format!("wall {}", c.id),
+                            normal: hit.normal,
+                            depth: hit.depth,
+                        });
+                    }
+                }
+                Shape::Disk => {
+                    let dist = d.length();
+                    let depth = c.radius + r - dist;
+                    if depth > 0.0 {
+                        // Coincident centres: out along the x axis, as contacts do.
+                        let normal = if dist > 0.0 { d / dist } else { V::unit_x() };
+                        consider(Overlap {
+                            what: format!("critter {}", c.id),
+                            normal,
+                            depth,
+                        });
+                    }
+                }
+            }
+        }
+        deepest
+    }
+
+    /// `p` moved out of the walls and critters a disk of radius `r` there overlaps, or the
+    /// overlap left after [`MAX_PUSHES`] moves.
+    fn push_free(&self, mut p: V, r: f64) -> Result<V, Overlap<V>> {
+        let margin = ROUNDING_MARGIN * r.max(1.0);
+        for _ in 0..MAX_PUSHES {
+            let Some(o) = self.deepest_overlap(p, r) else {
+                return Ok(p);
+            };
+            p = p + o.normal * (o.depth + margin);
+            for axis in 0..V::DIM {
+                let (lo, hi) = (self.topo.min.get(axis), self.topo.max.get(axis));
+                p.set(axis, p.get(axis).clamp(lo, hi));
+            }
+        }
+        self.deepest_overlap(p, r).map_or(Ok(p), Err)
     }
 
     /// The critter `spec` asks for, checked: errors name the critter and the bad field.

@@ -28,6 +28,7 @@ mod step;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use build::{OnOverlap, Placed};
 pub use config::WorldConfig;
 pub use diagnostics::Diagnostics;
 pub use layout::{Locality, LOCALITY};

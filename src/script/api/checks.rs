@@ -39,7 +39,7 @@ fn show(ctx: &NativeCallContext, v: &Dynamic) -> String {
         .unwrap_or_else(|_| v.to_string())
 }
 
-fn assert_near(a: &Dynamic, b: &Dynamic, tol: &Dynamic) -> Res<()> {
+fn assert_near(a: &Dynamic, b: &Dynamic, tol: &Dynamic, msg: Option<&Dynamic>) -> Res<()> {
     let tol = num(tol).map_or_else(|| fail("assert_near's tolerance must be a number"), Ok)?;
     let gap = match (
         num(a),
@@ -60,8 +60,9 @@ fn assert_near(a: &Dynamic, b: &Dynamic, tol: &Dynamic) -> Res<()> {
     if gap <= tol {
         Ok(())
     } else {
+        let why = msg.map(|m| format!(": {m}")).unwrap_or_default();
         fail(format!(
-            "assert_near failed: {a} and {b} differ by {gap:e}, more than {tol:e}"
+            "assert_near failed{why}: {a} and {b} differ by {gap:e}, more than {tol:e}"
         ))
     }
 }
@@ -119,7 +120,13 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     );
     engine.register_fn(
         "assert_near",
-        |a: Dynamic, b: Dynamic, tol: Dynamic| -> Res<()> { assert_near(&a, &b, &tol) },
+        |a: Dynamic, b: Dynamic, tol: Dynamic| -> Res<()> { assert_near(&a, &b, &tol, None) },
+    );
+    engine.register_fn(
+        "assert_near",
+        |a: Dynamic, b: Dynamic, tol: Dynamic, msg: Dynamic| -> Res<()> {
+            assert_near(&a, &b, &tol, Some(&msg))
+        },
     );
     let h = host.clone();
     engine.register_fn("expect_dead", move |c: CritterRef| -> Res<()> {

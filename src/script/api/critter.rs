@@ -234,13 +234,13 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         "is_kind",
         move |r: &mut CritterRef, kind: &str| -> Res<bool> {
             let id = r.0;
+            // An unknown kind is an error, not `false`: it is most likely a typo.
+            let k = super::spawn::kind_for_query(&h, kind)?;
             with_env!(h, env => {
                 let kinds = env.kinds();
-                match (env.critter(id), kinds.id(kind)) {
-                    (Some(c), Ok(k)) => Ok(kinds.is_kind(c.kind(), k)),
-                    (None, _) => Err(gone(id)),
-                    // An unknown kind name: nothing is of that kind (it may simply not be loaded).
-                    (Some(_), Err(_)) => Ok(false),
+                match env.critter(id) {
+                    Some(c) => Ok(kinds.is_kind(c.kind(), k)),
+                    None => Err(gone(id)),
                 }
             })
         },

@@ -368,7 +368,12 @@ fn spawn_syntax(
     if in_world {
         ensure_kind(h, &kind)?;
     }
-    with_env!(h, env => spawn_in(env, h, &kind, &map))
+    let origin = if in_world {
+        None
+    } else {
+        super::spawn::origin_here(h, ctx, inputs[0].position())
+    };
+    with_env!(h, env => super::spawn::spawn_from(env, h, &kind, &map, origin))
 }
 
 fn rotated_box<V: Vector>(center: V, size: DVec3, rot: DMat3) -> Res<WallBox<V>> {

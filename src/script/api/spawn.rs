@@ -1,13 +1,23 @@
-//! Spawns requested by scripts: the spawn map (`#{ pos: ..., vel: ..., ... }`) and the per-step
-//! limit on spawns.
+//! Spawns requested by scripts: the spawn map (`#{ pos: ..., vel: ..., ... }`), its
+//! `on_overlap` policy, where a spawn inside a step was asked for, and the per-step limit on
+//! spawns.
+//!
+//! A spawn from a hook is queued for the end of the step; its `on_overlap` defaults to `"push"`
+//! there, so a critter spawned against a wall or another critter never aborts the run. Between
+//! steps (a scene, a test) it defaults to `"error"`, as a scene's spawn always checked.
 
 use super::values::{from_svec, num_or, to_prop, vec_of};
-use super::{fail, lib_err, CritterRef, Res};
+use super::{error, fail, CritterRef, Res, HINT_MARK};
+use crate::context::SpawnOrigin;
 use crate::critter::CritterSpec;
+use crate::kind::KindId;
 use crate::script::env::Env;
-use crate::script::host::Host;
+use crate::script::host::{with_env, Host};
+use crate::script::kind::load_into;
 use crate::vector::Vector;
+use crate::world::{OnOverlap, Placed};
 use rhai::{Dynamic, Map};
+use std::rc::Rc;
 
 /// The fields a spawn map may set.
 const SPAWN_FIELDS: &[&str] = &[
@@ -21,7 +31,11 @@ const SPAWN_FIELDS: &[&str] = &[
     "restitution",
     "health",
     "props",
+    "on_overlap",
 ];
+
+/// `on_overlap` of a spawn inside a step when the map does not say.
+pub(crate) const HOOK_ON_OVERLAP: OnOverlap = OnOverlap::Push;
 
 /// A spawn request from a script: `spawn(kind, #{ pos: ..., vel: ..., ... })`.
 pub(crate) fn spec_from_map<V: Vector>(kind: &str, map: &Map) -> Res<CritterSpec<V>> {
@@ -41,6 +55,8 @@ pub(crate) fn spec_from_map<V: Vector>(kind: &str, map: &Map) -> Res<CritterSpec
                 Some(b) => spec.fixed = Some(b),
                 None => return fail("fixed must be true or false"),
             },
+            // Read by `on_overlap_of`.
+            "on_overlap" => {}
             "props" => match value.clone().try_cast::<Map>() {
                 Some(props) => {
                     for (name, v) in props {
@@ -77,6 +93,22 @@ fn count_spawn(host: &Host, step: u64) -> Res<()> {
     Ok(())
 }
 
+/// The `on_overlap` of a spawn map, or `default`.
+fn on_overlap_of(map: &Map, default: OnOverlap) -> Res<OnOverlap> {
+    let Some(value) = map.get("on_overlap") else {
+        return Ok(default);
+    };
+    let name = value.clone().into_string().unwrap_or_default();
+    OnOverlap::parse(&name).map_or_else(
+        || {
+            fail(format!(
+                "on_overlap is \"error\", \"skip\" or \"push\", not {value}"
+            ))
+        },
+        Ok,
+    )
+}
+
 /// Spawns from a script, now between steps or queued inside one.
 pub(crate) fn spawn_in<V: Vector>(
     env: &mut dyn Env<V>,
@@ -84,11 +116,127 @@ pub(crate) fn spawn_in<V: Vector>(
     kind: &str,
     map: &Map,
 ) -> Res<Dynamic> {
+    spawn_from(env, host, kind, map, None)
+}
+
+/// As [`spawn_in`]; a spawn queued inside a step keeps `origin` for its errors.
+pub(crate) fn spawn_from<V: Vector>(
+    env: &mut dyn Env<V>,
+    host: &Host,
+    kind: &str,
+    map: &Map,
+    origin: Option<Box<SpawnOrigin>>,
+) -> Res<Dynamic> {
     count_spawn(host, env.step_count())?;
-    env.kinds().id(kind).map_err(lib_err)?;
+    if let Err(e) = env.kinds().id(kind) {
+        return Err(unknown_kind_in_step(kind, e));
+    }
     let spec = spec_from_map::<V>(kind, map)?;
-    match env.spawn(spec).map_err(|e| host.carry(e))? {
-        Some(id) => Ok(Dynamic::from(CritterRef(id))),
+    let in_step = env.world().is_none();
+    let policy = on_overlap_of(
+        map,
+        if in_step {
+            HOOK_ON_OVERLAP
+        } else {
+            OnOverlap::Error
+        },
+    )?;
+    match env
+        .spawn_placed(spec, policy, origin)
+        .map_err(|e| host.carry(e))?
+    {
+        Some(Placed::Added(id)) => Ok(Dynamic::from(CritterRef(id))),
+        Some(Placed::Skipped(why)) => {
+            env.log(format!("warning: spawn skipped: {why}"));
+            Ok(Dynamic::UNIT)
+        }
         None => Ok(Dynamic::UNIT),
     }
+}
+
+/// The error for kind `kind`, not loaded in a world that is in the middle of a step.
+pub(crate) fn unknown_kind_in_step(kind: &str, e: crate::Error) -> Box<rhai::EvalAltResult> {
+    let known = match &e {
+        crate::Error::UnknownKind { known, .. } => known.clone(),
+        _ => String::new(),
+    };
+    error(format!(
+        "unknown kind '{kind}' (known kinds: {known}){HINT_MARK}a kind named as a string literal in a kind file loads before the run; \
+         a name computed at run time must be loaded first with load_kind(\"{kind}\") in the scene or test",
+    ))
+}
+
+/// The id of kind `name` for a query (`is_kind`, `count`, `critters_of`): between steps it
+/// loads on first use; inside a step a kind not loaded is an error naming the known kinds.
+pub(crate) fn kind_for_query(host: &Rc<Host>, name: &str) -> Res<KindId> {
+    let found = with_env!(host, env => Ok(env.kinds().id(name)))?;
+    let e = match found {
+        Ok(id) => return Ok(id),
+        Err(e) => e,
+    };
+    let rt = host.runtime()?;
+    with_env!(host, env => match env.world() {
+        Some(world) => load_into(&rt, world, name).map_err(|e| host.carry(e)),
+        None => Err(unknown_kind_in_step(name, e)),
+    })
+}
+
+/// Where a spawn inside a step is asked for: the call's file and position, the hook around it
+/// and the critter it runs for (a hook's first parameter), for the spawn's errors.
+pub(crate) fn origin_here(
+    host: &Host,
+    ctx: &rhai::EvalContext,
+    pos: rhai::Position,
+) -> Option<Box<SpawnOrigin>> {
+    let rt = host.runtime().ok()?;
+    let critter = ctx
+        .scope()
+        .iter()
+        .next()
+        .and_then(|(_, _, v)| v.try_cast::<CritterRef>())
+        .map(|c| c.0);
+    let here: Res<Option<(u64, Option<String>)>> = with_env!(host, env => {
+        if env.world().is_some() {
+            Ok(None)
+        } else {
+            let kind = critter
+                .and_then(|id| env.critter(id))
+                .map(|c| env.kinds().name(c.kind()).to_string());
+            Ok(Some((env.step_count(), kind)))
+        }
+    });
+    let (step, kind) = here.ok().flatten()?;
+    let kind_file = kind
+        .as_ref()
+        .and_then(|k| rt.kinds.borrow().get(k).map(|d| d.file.clone()));
+    let file = ctx
+        .source()
+        .map(str::to_string)
+        .or(kind_file)
+        .unwrap_or_default();
+    let hook = rt
+        .sources
+        .borrow()
+        .iter()
+        .find(|s| s.path == file)
+        .and_then(|s| enclosing_fn(&s.text, pos.line()?));
+    Some(Box::new(SpawnOrigin {
+        file,
+        line: pos.line(),
+        column: pos.position(),
+        kind,
+        hook,
+        critter,
+        step,
+    }))
+}
+
+/// The name of the last `fn name(` that starts a line at or before line `line` of `text`.
+fn enclosing_fn(text: &str, line: usize) -> Option<String> {
+    text.lines()
+        .take(line)
+        .filter_map(|l| l.trim_start().strip_prefix("fn "))
+        .filter_map(|rest| rest.split('(').next())
+        .map(|name| name.trim().to_string())
+        .last()
 }

@@ -2,7 +2,7 @@
 //! `w.critters_of(kind)`, `w.count(kind)`), and its log: `log(...)`, `print` and `debug`.
 
 use super::critter::CritterRef;
-use super::{lib_err, Res};
+use super::Res;
 use crate::script::host::{with_env, Host};
 use rhai::{Array, Dynamic, Engine, EvalAltResult, INT};
 use std::rc::Rc;
@@ -50,20 +50,16 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_fn(
         "critters_of",
         move |_: &mut WorldRef, kind: &str| -> Res<Array> {
+            let k = super::spawn::kind_for_query(&h, kind)?;
             with_env!(h, env => {
-                let k = env.kinds().id(kind).map_err(lib_err)?;
                 Ok(env.critters_of(k).into_iter().map(|id| Dynamic::from(CritterRef(id))).collect())
             })
         },
     );
     let h = host.clone();
     engine.register_fn("count", move |_: &mut WorldRef, kind: &str| -> Res<INT> {
-        with_env!(h, env => {
-            match env.kinds().id(kind) {
-                Ok(k) => Ok(env.critters_of(k).len() as INT),
-                Err(_) => Ok(0),
-            }
-        })
+        let k = super::spawn::kind_for_query(&h, kind)?;
+        with_env!(h, env => Ok(env.critters_of(k).len() as INT))
     });
     let h = host.clone();
     engine.register_fn("log", move |_: &mut WorldRef, line: Dynamic| -> Res<()> {

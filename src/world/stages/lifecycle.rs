@@ -4,6 +4,7 @@
 use crate::error::Error;
 use crate::method::state::MethodState;
 use crate::vector::Vector;
+use crate::world::build::Placed;
 use crate::world::state::State;
 
 /// Removes the step's dead and adds its queued spawns.
@@ -27,9 +28,20 @@ pub(crate) fn run<V: Vector>(
     if !gone.is_empty() {
         methods.removed(&state.topo, &gone, state.critters.slot_slice());
     }
-    for spec in std::mem::take(&mut state.pending.spawns) {
-        let id = state.spawn(spec)?;
-        state.events.spawns.push(id);
+    for p in std::mem::take(&mut state.pending.spawns) {
+        match state.spawn_placed(p.spec, p.on_overlap) {
+            Ok(Placed::Added(id)) => state.events.spawns.push(id),
+            Ok(Placed::Skipped(why)) => state.events.log.push(match &p.origin {
+                Some(o) => format!("warning: {}: spawn skipped: {why}", o.place()),
+                None => format!("warning: spawn skipped: {why}"),
+            }),
+            Err(e) => {
+                return Err(match p.origin {
+                    Some(o) => o.locate(e),
+                    None => e,
+                })
+            }
+        }
     }
     Ok(())
 }
