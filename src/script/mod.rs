@@ -15,8 +15,10 @@ pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
 pub(crate) mod kind_refs;
-pub(crate) mod lint;
+pub mod lint;
 pub(crate) mod scene;
+
+pub use lint::{check_file, check_files, FileCheck, Problem, Severity};
 
 use crate::error::{Error, ScriptError};
 use crate::scenes::{Scene, SourceFile};

@@ -192,13 +192,15 @@ impl<V: Vector> State<V> {
             }
             OnOverlap::Push => match self.push_free(spec.pos, radius) {
                 Ok(p) => spec.pos = p,
-                Err(o) => return Ok(Placed::Skipped(format!(
+                Err(o) => {
+                    return Ok(Placed::Skipped(format!(
                     "the {} to spawn at {} still overlaps {} by {:.3} after {MAX_PUSHES} pushes",
                     spec.kind,
                     fmt_vec(spec.pos),
                     o.what,
                     o.depth
-                ))),
+                )))
+                }
             },
         }
         self.spawn(spec).map(Placed::Added)

@@ -15,7 +15,7 @@ use std::time::Duration;
 pub struct TestArgs {
     /// Test scripts or folders of them (default: scripts/tests).
     pub paths: Vec<PathBuf>,
-    /// Run only the tests whose `file::name` contains this text.
+    /// Run only the tests whose `file::name` contains this text (matching none is a failure).
     #[arg(long)]
     pub filter: Option<String>,
     /// Tests run at once (default: the number of cores).
@@ -52,6 +52,13 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         show_paths(&paths)
     );
     let cases = discover(&files, args.filter.as_deref());
+    if let (Some(filter), true) = (&args.filter, cases.is_empty()) {
+        let all = discover(&files, None).len();
+        anyhow::bail!(
+            "--filter {filter:?} matches none of the {all} tests in {}: nothing ran",
+            show_paths(&files)
+        );
+    }
     let options = TestOptions {
         script: ScriptOptions {
             limits: Limits {
