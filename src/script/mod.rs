@@ -83,6 +83,9 @@ pub(crate) struct Runtime {
     pub sources: RefCell<Vec<SourceFile>>,
     /// The limits the engine was built with.
     pub limits: Limits,
+    /// Whether a kind name has a file on the kind search path, once asked (see
+    /// [`Runtime::kind_exists`]).
+    kind_files: RefCell<BTreeMap<String, bool>>,
 }
 
 /// What a layer above scripts adds to a runtime (the script test runner's API): functions on
@@ -127,6 +130,7 @@ impl Runtime {
                 kinds: RefCell::new(BTreeMap::new()),
                 sources: RefCell::new(Vec::new()),
                 limits: options.limits.clone(),
+                kind_files: RefCell::new(BTreeMap::new()),
             }
         })
     }
@@ -137,6 +141,20 @@ impl Runtime {
             .iter()
             .map(|dir| dir.join(format!("{name}.rhai")))
             .find(|p| p.is_file())
+    }
+
+    /// True when `name` is a kind: native, loaded, or a file on the kind search path (looked
+    /// up once per name, as hooks may ask every step).
+    pub fn kind_exists(&self, name: &str) -> bool {
+        if kind_refs::NATIVE_KINDS.contains(&name) || self.kinds.borrow().contains_key(name) {
+            return true;
+        }
+        if let Some(&known) = self.kind_files.borrow().get(name) {
+            return known;
+        }
+        let found = self.resolve_kind(name).is_some();
+        self.kind_files.borrow_mut().insert(name.to_string(), found);
+        found
     }
 
     /// The names of every kind on the kind search path, and the native ones.

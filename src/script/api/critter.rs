@@ -239,7 +239,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
             with_env!(h, env => {
                 let kinds = env.kinds();
                 match env.critter(id) {
-                    Some(c) => Ok(kinds.is_kind(c.kind(), k)),
+                    Some(c) => Ok(k.is_some_and(|k| kinds.is_kind(c.kind(), k))),
                     None => Err(gone(id)),
                 }
             })

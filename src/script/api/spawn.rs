@@ -166,17 +166,27 @@ pub(crate) fn unknown_kind_in_step(kind: &str, e: crate::Error) -> Box<rhai::Eva
     ))
 }
 
-/// The id of kind `name` for a query (`is_kind`, `count`, `critters_of`): between steps it
-/// loads on first use; inside a step a kind not loaded is an error naming the known kinds.
-pub(crate) fn kind_for_query(host: &Rc<Host>, name: &str) -> Res<KindId> {
+/// The id of kind `name` for a query (`is_kind`, `count`, `critters_of`). Between steps the
+/// kind loads on first use. Inside a step, a kind that exists but is not loaded has no critters
+/// in the world (`None`); a name that is no kind at all is an error naming the known kinds, as
+/// it is almost always a typo.
+pub(crate) fn kind_for_query(host: &Rc<Host>, name: &str) -> Res<Option<KindId>> {
     let found = with_env!(host, env => Ok(env.kinds().id(name)))?;
     let e = match found {
-        Ok(id) => return Ok(id),
+        Ok(id) => return Ok(Some(id)),
         Err(e) => e,
     };
     let rt = host.runtime()?;
+    let in_step = with_env!(host, env => Ok(env.world().is_none()))?;
+    if in_step {
+        return if rt.kind_exists(name) {
+            Ok(None)
+        } else {
+            Err(unknown_kind_in_step(name, e))
+        };
+    }
     with_env!(host, env => match env.world() {
-        Some(world) => load_into(&rt, world, name).map_err(|e| host.carry(e)),
+        Some(world) => load_into(&rt, world, name).map(Some).map_err(|e| host.carry(e)),
         None => Err(unknown_kind_in_step(name, e)),
     })
 }

@@ -50,7 +50,9 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_fn(
         "critters_of",
         move |_: &mut WorldRef, kind: &str| -> Res<Array> {
-            let k = super::spawn::kind_for_query(&h, kind)?;
+            let Some(k) = super::spawn::kind_for_query(&h, kind)? else {
+                return Ok(Array::new());
+            };
             with_env!(h, env => {
                 Ok(env.critters_of(k).into_iter().map(|id| Dynamic::from(CritterRef(id))).collect())
             })
@@ -58,7 +60,9 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     );
     let h = host.clone();
     engine.register_fn("count", move |_: &mut WorldRef, kind: &str| -> Res<INT> {
-        let k = super::spawn::kind_for_query(&h, kind)?;
+        let Some(k) = super::spawn::kind_for_query(&h, kind)? else {
+            return Ok(0);
+        };
         with_env!(h, env => Ok(env.critters_of(k).len() as INT))
     });
     let h = host.clone();
