@@ -30,16 +30,11 @@ pub(crate) trait Env<V: Vector> {
     fn spawn_placed(
         &mut self,
         spec: CritterSpec<V>,
-        on_overlap: OnOverlap,
+        _on_overlap: OnOverlap,
         _origin: Option<Box<SpawnOrigin>>,
     ) -> Result<Option<Placed>, Error> {
-        if on_overlap == OnOverlap::Error {
-            return Ok(self.spawn(spec)?.map(Placed::Added));
-        }
-        Err(Error::InvalidKind {
-            kind: spec.kind,
-            reason: "on_overlap is for spawns in a scene, a test or a hook".into(),
-        })
+        // Only the world and a hook's access place spawns; elsewhere `spawn` says why not.
+        Ok(self.spawn(spec)?.map(Placed::Added))
     }
     fn log(&mut self, line: String);
     fn critters_of(&self, kind: KindId) -> Vec<CritterId>;

@@ -256,7 +256,7 @@ impl<V: Vector> State<V> {
             let Some(o) = self.deepest_overlap(p, r) else {
                 return Ok(p);
             };
-            p = p + o.normal * (o.depth + margin);
+            p += o.normal * (o.depth + margin);
             for axis in 0..V::DIM {
                 let (lo, hi) = (self.topo.min.get(axis), self.topo.max.get(axis));
                 p.set(axis, p.get(axis).clamp(lo, hi));
