@@ -234,7 +234,19 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         "is_kind",
         move |r: &mut CritterRef, kind: &str| -> Res<bool> {
             let id = r.0;
-            // An unknown kind is an error, not `false`: it is most likely a typo.
+            let known = with_env!(h, env => {
+                let kinds = env.kinds();
+                match (env.critter(id), kinds.id(kind)) {
+                    (Some(c), Ok(k)) => Ok(Some(kinds.is_kind(c.kind(), k))),
+                    (None, _) => Err(gone(id)),
+                    (Some(_), Err(_)) => Ok(None),
+                }
+            })?;
+            if let Some(answer) = known {
+                return Ok(answer);
+            }
+            // Not in this world: loaded now, or none of it here, or (no such kind) an error,
+            // not `false`, as it is most likely a typo.
             let k = super::spawn::kind_for_query(&h, kind)?;
             with_env!(h, env => {
                 let kinds = env.kinds();
