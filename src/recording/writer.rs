@@ -282,6 +282,7 @@ impl Drop for Recorder {
                 outcome: "aborted".into(),
                 reason: "the recorder was dropped before the run finished".into(),
                 hash: 0,
+                ..EndMeta::default()
             };
             let _ = self.close(end);
         }
@@ -325,6 +326,7 @@ impl Output {
                     outcome: "aborted".into(),
                     reason: "the run ended without closing the recording".into(),
                     hash: 0,
+                    ..EndMeta::default()
                 })),
             };
             match job {

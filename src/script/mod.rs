@@ -14,6 +14,7 @@ pub(crate) mod env;
 pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
+pub mod profile;
 pub(crate) mod scene;
 
 use crate::error::{Error, ScriptError};
@@ -65,6 +66,8 @@ pub struct ScriptOptions {
     pub kind_dirs: Vec<PathBuf>,
     /// A seed that overrides the scene's own.
     pub seed: Option<u64>,
+    /// Time every hook call per kind and hook from the start ([`profile`]; `run --stats`).
+    pub profile: bool,
 }
 
 /// The engine, the kinds loaded so far, and the bridge to the world.
@@ -79,6 +82,8 @@ pub(crate) struct Runtime {
     pub sources: RefCell<Vec<SourceFile>>,
     /// The limits the engine was built with.
     pub limits: Limits,
+    /// Calls and time per kind and hook, when turned on.
+    pub profiler: Rc<profile::Profiler>,
 }
 
 /// What a layer above scripts adds to a runtime (the script test runner's API): functions on
@@ -116,6 +121,8 @@ impl Runtime {
                 runtime.clone(),
             ));
             host.seed_override.set(options.seed);
+            let profiler = Rc::new(profile::Profiler::default());
+            profiler.set_on(options.profile);
             Runtime {
                 engine: api::build_engine(&host, &options.limits),
                 host,
@@ -123,6 +130,7 @@ impl Runtime {
                 kinds: RefCell::new(BTreeMap::new()),
                 sources: RefCell::new(Vec::new()),
                 limits: options.limits.clone(),
+                profiler,
             }
         })
     }

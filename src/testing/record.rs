@@ -19,6 +19,7 @@ fn end_meta(world: &AnyWorld, outcome: &str, reason: String) -> EndMeta {
         outcome: outcome.into(),
         reason,
         hash: world.state_hash(),
+        ..EndMeta::default()
     }
 }
 

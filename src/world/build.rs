@@ -89,6 +89,7 @@ impl<V: Vector> State<V> {
                 health: 1.0,
                 shape: Shape::Wall(Box::new(wall)),
                 props: Default::default(),
+                color: None,
             }),
         });
         self.walls.push(id);
@@ -222,6 +223,7 @@ impl<V: Vector> State<V> {
                     props.extend(spec.props);
                     props
                 },
+                color: None,
             }),
         })
     }

@@ -5,12 +5,16 @@ use super::World;
 use crate::hash::{StateHasher, LANES};
 use crate::vector::Vector;
 
+/// Marks where `world().vars` starts in the hashed words ("vars" in ASCII).
+const VARS_TAG: u64 = 0x7661_7273;
+
 impl<V: Vector> World<V> {
     /// A hash of the whole dynamic state over raw float bits: equal hashes mean (with
     /// overwhelming probability) bit-identical worlds. It covers the step count, dt, the
     /// generator's state and, for every critter, id, kind, fixed, alive, position, velocity,
-    /// radius, mass, priority, restitution, health and properties, and under `solve:n` the
-    /// critters' counts of quiet steps towards sleep.
+    /// radius, mass, priority, restitution, health and properties, under `solve:n` the
+    /// critters' counts of quiet steps towards sleep, and the scripts' `world().vars` when not
+    /// empty.
     pub fn state_hash(&self) -> u64 {
         self.state_hash_and_totals().0
     }
@@ -43,6 +47,12 @@ impl<V: Vector> World<V> {
         for (slot, q, island) in self.methods.quiet_counts() {
             h.word((slot as u64) << 16 | u64::from(q));
             h.word(u64::from(island));
+        }
+        // The scripts' shared state, when there is any (a world without it hashes as it did
+        // before it existed); the tag keeps it apart from the quiet steps' words.
+        if !self.state.vars.is_empty() {
+            h.word(VARS_TAG);
+            crate::hash::critters::hash_named(&mut h, &self.state.vars);
         }
         (h.finish(), pass.energy, pass.momentum)
     }
