@@ -57,3 +57,62 @@ impl<V: Vector> World<V> {
         (h.finish(), pass.energy, pass.momentum)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::critter::{CritterSpec, PropValue};
+    use crate::world::{World, WorldConfig};
+    use glam::DVec2;
+
+    fn world() -> World<DVec2> {
+        let config = WorldConfig::new(DVec2::ZERO, DVec2::new(10.0, 10.0));
+        let mut w = World::new(config).expect("a world");
+        w.spawn(CritterSpec::ball(DVec2::new(1.0, 1.0)).vel(DVec2::new(0.5, 0.0)))
+            .expect("a ball");
+        w
+    }
+
+    /// Vars are hashed when there are any, every name and value counts, and a world whose
+    /// vars are empty hashes as one that never had any (so scenes without vars keep their
+    /// hashes).
+    #[test]
+    fn vars_change_the_hash_and_empty_vars_hash_as_none() {
+        let mut w = world();
+        let none = w.state_hash();
+        let mut seen = vec![none];
+        let mut differs = |w: &World<DVec2>, what: &str| {
+            let h = w.state_hash();
+            assert!(!seen.contains(&h), "{what}: the hash did not change");
+            seen.push(h);
+        };
+        w.vars_mut().insert("score".into(), PropValue::Int(1));
+        differs(&w, "a var");
+        w.vars_mut().insert("score".into(), PropValue::Int(2));
+        differs(&w, "its value");
+        w.vars_mut().insert("score".into(), PropValue::Float(2.0));
+        differs(&w, "its type");
+        let nested = |hits| {
+            PropValue::Map(
+                [("hits".to_string(), PropValue::Int(hits))]
+                    .into_iter()
+                    .collect(),
+            )
+        };
+        w.vars_mut().insert("best".into(), nested(0));
+        differs(&w, "a map var");
+        w.vars_mut().insert("best".into(), nested(1));
+        differs(&w, "a value inside it");
+        let renamed = w.vars_mut().remove("best");
+        w.vars_mut().insert("bets".into(), renamed.expect("there"));
+        differs(&w, "a name");
+        w.vars_mut().clear();
+        assert_eq!(w.state_hash(), none, "empty vars hash as no vars");
+        // A colour changes what is drawn, not what happens: not hashed.
+        let id = w.critters().iter().next().expect("the ball").id();
+        w.get_mut(id)
+            .expect("there")
+            .set_color(Some("red"))
+            .expect("a colour");
+        assert_eq!(w.state_hash(), none);
+    }
+}
