@@ -1,6 +1,7 @@
 //! The cost of script kinds on the standard gas (10,000 disks, packing fraction 0.4): native
 //! balls against balls whose `collide` is a script calling `collide_default`, and against balls
-//! with an `update` hook, in one run. `docs/scripting.md` reports the figures.
+//! with an `update` hook, in one run; `+profiled` cases time every hook call as `run --stats`
+//! does. `docs/scripting.md` reports the figures.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use critterbox::glam::DVec2;
