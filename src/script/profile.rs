@@ -91,7 +91,7 @@ impl Profiler {
 /// costly first.
 pub fn table(rows: &[ProfileRow]) -> String {
     let mut rows = rows.to_vec();
-    rows.sort_by(|a, b| b.total_ns.cmp(&a.total_ns));
+    rows.sort_by_key(|r| std::cmp::Reverse(r.total_ns));
     let width = |f: fn(&ProfileRow) -> usize, min: usize| rows.iter().map(f).fold(min, usize::max);
     let (wk, wh) = (width(|r| r.kind.len(), 4), width(|r| r.hook.len(), 4));
     let mut out = String::new();
