@@ -312,7 +312,10 @@ fn test_fails_after_a_long_run() {
     assert!(states <= 600 / 30 + 2, "{states} full states");
     let bytes = std::fs::metadata(&file).expect("file").len();
     assert!(bytes < 2 << 20, "{bytes} bytes");
-    // It can be inspected.
+    // It can be inspected, and a recorded step shown.
     let o = critterbox_in(&dir, &["inspect", file.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
+    let o = critterbox_in(&dir, &["replay", file.to_str().unwrap(), "--step", "60"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("vars_counter"), "{}", text(&o));
 }
