@@ -60,6 +60,7 @@ fn run(scene: &mut Scene, steps: u64, every: Option<u64>, path: &Path) -> Durati
             outcome: "completed".into(),
             reason: String::new(),
             hash: 0,
+            ..EndMeta::default()
         };
         r.finish(&scene.world, end).expect("finishes");
     }

@@ -2,7 +2,7 @@
 //! queues for structural changes (deaths, spawns) that take effect after the step.
 
 use crate::border::Topology;
-use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::critter::{Critter, CritterId, CritterSpec, Props};
 use crate::critter_set::CritterSet;
 use crate::error::{Error, ScriptError};
 use crate::kind::{KindId, KindSet};
@@ -122,6 +122,7 @@ pub struct Access<'a, V: Vector> {
     pub(crate) topo: &'a Topology<V>,
     pub(crate) pending: &'a mut Pending<V>,
     pub(crate) events: &'a mut StepEvents<V>,
+    pub(crate) vars: &'a mut Props,
     pub(crate) rng: &'a mut Rng,
     pub(crate) step: u64,
     pub(crate) time: f64,
@@ -160,6 +161,14 @@ impl<V: Vector> Access<'_, V> {
     /// The world's seeded generator.
     pub fn rng(&mut self) -> &mut Rng {
         self.rng
+    }
+    /// The scripts' shared state (`world().vars`).
+    pub fn vars(&self) -> &Props {
+        self.vars
+    }
+    /// The scripts' shared state, to change.
+    pub fn vars_mut(&mut self) -> &mut Props {
+        self.vars
     }
     /// True when critter `id` is of kind `kind` or a kind that extends it.
     pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {

@@ -80,6 +80,8 @@ pub enum PropValue {
     List(Vec<PropValue>),
     /// A vector (z = 0 in 2D).
     Vector([f64; 3]),
+    /// Named values, ordered by name (for `world().vars`, whose values may be maps).
+    Map(BTreeMap<String, PropValue>),
 }
 
 /// A critter's user properties, ordered by name so iteration is deterministic.
@@ -144,6 +146,9 @@ pub(crate) struct Traits<V: Vector> {
     pub(crate) shape: Shape<V>,
     /// User properties.
     pub(crate) props: Props,
+    /// The colour a script gave this critter (`me.color`), as written; `None` draws it in its
+    /// kind's colour. Not hashed: it changes what a viewer shows, never what happens.
+    pub(crate) color: Option<String>,
 }
 
 impl<V: Vector> Traits<V> {
@@ -154,6 +159,8 @@ impl<V: Vector> Traits<V> {
         matches!((&self.shape, &o.shape), (Shape::Disk, Shape::Disk))
             && self.props.is_empty()
             && o.props.is_empty()
+            && self.color.is_none()
+            && o.color.is_none()
             && self.kind == o.kind
             && self.mass.to_bits() == o.mass.to_bits()
             && self.priority.to_bits() == o.priority.to_bits()
@@ -292,6 +299,30 @@ impl<V: Vector> Critter<V> {
     /// User properties, to change.
     pub fn props_mut(&mut self) -> &mut Props {
         &mut self.traits_mut().props
+    }
+    /// The colour a script gave this critter, if any (else its kind's colour applies).
+    pub fn color(&self) -> Option<&str> {
+        self.traits.color.as_deref()
+    }
+    /// Gives the critter its own colour: a colour name or `#rrggbb` (see [`crate::color`]);
+    /// `None` goes back to the kind's colour.
+    pub fn set_color(&mut self, color: Option<&str>) -> Result<(), crate::Error> {
+        let color =
+            match color {
+                Some(c) => Some(crate::color::checked(c).map_err(|reason| {
+                    crate::Error::InvalidCritter {
+                        critter: self.describe(),
+                        field: "color",
+                        value: c.to_string(),
+                        reason,
+                    }
+                })?),
+                None => None,
+            };
+        if self.traits.color != color {
+            self.traits_mut().color = color;
+        }
+        Ok(())
     }
     /// The traits to change: the critter's own copy, made now if it shares them.
     pub(crate) fn traits_mut(&mut self) -> &mut Traits<V> {

@@ -45,6 +45,7 @@ mod wall;
 // The broad phase on its own, for its tests and benches.
 #[doc(hidden)]
 pub mod broad_phase;
+pub mod color;
 
 pub mod method;
 pub mod recording;

@@ -376,6 +376,8 @@ struct Frame {
     radius: Vec<f32>,
     pos: Vec<[f32; 3]>,
     vel: Vec<[f32; 3]>,
+    /// The colour a script gave each critter (`me.color`), if any.
+    color: Vec<Option<[u8; 3]>>,
     /// Contact points and impulses (normal times impulse).
     contacts: Vec<([f32; 3], [f32; 3])>,
     spawns: Vec<CritterId>,
@@ -400,6 +402,7 @@ impl Frame {
             radius: Vec::new(),
             pos: Vec::new(),
             vel: Vec::new(),
+            color: Vec::new(),
             contacts: Vec::new(),
             spawns: Vec::new(),
             deaths: Vec::new(),
@@ -434,6 +437,7 @@ impl Frame {
         refill(&mut f.radius, n);
         refill(&mut f.pos, n);
         refill(&mut f.vel, n);
+        refill(&mut f.color, n);
         // The same sums, in the same order, as World::kinetic_energy and World::momentum.
         let mut energy = 0.0;
         let mut momentum = V::zero();
@@ -451,6 +455,11 @@ impl Frame {
             f.radius.push(c.radius() as f32);
             f.pos.push(f32x3(c.pos));
             f.vel.push(f32x3(c.vel));
+            f.color
+                .push(c.color().and_then(crate::color::parse).map(|rgba| {
+                    let ch = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    [ch(rgba[0]), ch(rgba[1]), ch(rgba[2])]
+                }));
         }
         f.kinetic_energy = energy;
         f.momentum = momentum.to_array3();
@@ -475,14 +484,15 @@ fn refill<T>(v: &mut Vec<T>, n: usize) {
     v.reserve(n);
 }
 
-/// What was last logged in full for a kind: the critters (ids, health bits, radius bits). While
-/// they stay the same, a step logs only positions and velocities; labels, radii and colours
+/// What was last logged in full for a kind: the critters (ids, health bits, radius bits,
+/// colours). While they stay the same, a step logs only positions and velocities; labels, radii and colours
 /// carry over in the viewer.
 #[derive(PartialEq)]
 struct Logged {
     id: Vec<CritterId>,
     health: Vec<u64>,
     radius: Vec<u32>,
+    color: Vec<[u8; 3]>,
 }
 
 /// The logging thread's side: builds Rerun's archetypes from frames, in step order.
@@ -528,10 +538,16 @@ impl Drawer {
         for (name, members) in &by_kind {
             let kind = f.kind[members[0]];
             let color = f.kinds.get(kind as usize).map_or([128; 3], |(_, c)| *c);
+            // Each critter in its own colour where a script gave it one, else its kind's.
+            let colors: Vec<[u8; 3]> = members
+                .iter()
+                .map(|&i| f.color[i].unwrap_or(color))
+                .collect();
             let now = Logged {
                 id: members.iter().map(|&i| f.id[i]).collect(),
                 health: members.iter().map(|&i| f.health[i].to_bits()).collect(),
                 radius: members.iter().map(|&i| f.radius[i].to_bits()).collect(),
+                color: colors.clone(),
             };
             let slot = self.kinds.entry(name.to_string()).or_insert(None);
             let full = slot.as_ref() != Some(&now);
@@ -548,7 +564,7 @@ impl Drawer {
                 let mut points = if full {
                     rerun::Points2D::new(pos.clone())
                         .with_radii(radii())
-                        .with_colors([color])
+                        .with_colors(colors.clone())
                 } else {
                     rerun::Points2D::update_fields().with_positions(pos.clone())
                 };
@@ -562,14 +578,14 @@ impl Drawer {
                         format!("world/velocities/{name}"),
                         &rerun::Arrows2D::from_vectors(vel)
                             .with_origins(pos)
-                            .with_colors([color]),
+                            .with_colors(colors.clone()),
                     );
                 }
             } else {
                 let pos: Vec<[f32; 3]> = members.iter().map(|&i| f.pos[i]).collect();
                 let mut spheres = if full {
                     rerun::Ellipsoids3D::from_centers_and_radii(pos.clone(), radii())
-                        .with_colors([color])
+                        .with_colors(colors.clone())
                 } else {
                     rerun::Ellipsoids3D::update_fields().with_centers(pos.clone())
                 };
@@ -583,7 +599,7 @@ impl Drawer {
                         format!("world/velocities/{name}"),
                         &rerun::Arrows3D::from_vectors(vel)
                             .with_origins(pos)
-                            .with_colors([color]),
+                            .with_colors(colors.clone()),
                     );
                 }
             }

@@ -106,6 +106,7 @@ fn round_trip_states_read_back_bit_for_bit() {
         outcome: "completed".into(),
         reason: String::new(),
         hash: scene.world.state_hash(),
+        ..Default::default()
     };
     let written = rec.finish(&scene.world, end).expect("finish");
     assert_eq!((written.steps, written.states), (40, 41));

@@ -430,7 +430,7 @@ pub(super) fn hash_props<V: Vector>(h: &mut StateHasher, c: &Critter<V>) {
     }
 }
 
-fn hash_prop(h: &mut StateHasher, value: &PropValue) {
+pub(crate) fn hash_prop(h: &mut StateHasher, value: &PropValue) {
     match value {
         PropValue::Bool(b) => h.word(*b as u64),
         PropValue::Int(i) => h.word(*i as u64),
@@ -448,6 +448,16 @@ fn hash_prop(h: &mut StateHasher, value: &PropValue) {
                 hash_prop(h, item);
             }
         }
+        PropValue::Map(map) => hash_named(h, map),
+    }
+}
+
+/// Named values (a map property, `world().vars`): how many, then names and values in order.
+pub(crate) fn hash_named(h: &mut StateHasher, map: &std::collections::BTreeMap<String, PropValue>) {
+    h.word(map.len() as u64);
+    for (name, value) in map {
+        hash_bytes(h, name.as_bytes());
+        hash_prop(h, value);
     }
 }
 

@@ -109,6 +109,8 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
             .quiet_steps()
             .map(|(id, q, island)| (id_key(id), q, island.map(id_key)))
             .collect(),
+        vars: world.vars().clone(),
+        colors: BTreeMap::new(),
     };
     for c in world.critters().iter() {
         let id = id_key(c.id());
@@ -131,6 +133,9 @@ pub fn state<V: Vector>(world: &World<V>) -> StateMsg {
         s.alive.push(c.is_alive());
         if !c.props().is_empty() {
             s.props.insert(id.to_string(), c.props().clone());
+        }
+        if let Some(color) = c.color() {
+            s.colors.insert(id.to_string(), color.to_string());
         }
         if let Some(w) = c.wall() {
             let v = |x: V| Floats((0..V::DIM).map(|a| x.get(a)).collect());

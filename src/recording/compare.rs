@@ -74,6 +74,16 @@ pub fn first_difference(a: &StateMsg, b: &StateMsg, a_name: &str, b_name: &str) 
                 json(pb)
             ));
         }
+        let (ca, cb) = (a.colors.get(&key), b.colors.get(&key));
+        if ca != cb {
+            let show = |c: Option<&String>| c.map_or("its kind's".to_string(), |c| c.clone());
+            return Some(format!(
+                "{}: colour {a_name} {}, {b_name} {}",
+                who(a, i),
+                show(ca),
+                show(cb)
+            ));
+        }
     }
     if a.len() != b.len() {
         let (longer, name) = if a.len() > b.len() {
@@ -91,6 +101,14 @@ pub fn first_difference(a: &StateMsg, b: &StateMsg, a_name: &str, b_name: &str) 
     let json = |s: &StateMsg| serde_json::to_string(&s.walls).unwrap_or_default();
     if json(a) != json(b) {
         return Some("the wall boxes differ".to_string());
+    }
+    if !same_json(&a.vars, &b.vars) {
+        let json = |s: &StateMsg| serde_json::to_string(&s.vars).unwrap_or_default();
+        return Some(format!(
+            "world().vars {a_name} {}, {b_name} {}",
+            json(a),
+            json(b)
+        ));
     }
     None
 }

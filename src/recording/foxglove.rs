@@ -6,56 +6,7 @@ use super::schema::{StateMsg, WallMsg};
 use serde_json::{json, Value};
 use std::fmt::Write;
 
-/// RGBA in [0, 1].
-pub type Rgba = [f32; 4];
-
-/// Colour of a kind: its `color` default if it names one we know, else one from a palette by
-/// kind index; walls are grey.
-pub fn kind_color(name: &str, color: Option<&str>, index: usize) -> Rgba {
-    if let Some(c) = color.and_then(parse_color) {
-        return c;
-    }
-    if name == "wall" {
-        return [0.55, 0.55, 0.6, 1.0];
-    }
-    const PALETTE: [Rgba; 6] = [
-        [0.25, 0.55, 0.95, 1.0],
-        [0.95, 0.55, 0.2, 1.0],
-        [0.3, 0.75, 0.35, 1.0],
-        [0.85, 0.3, 0.35, 1.0],
-        [0.6, 0.4, 0.85, 1.0],
-        [0.9, 0.8, 0.25, 1.0],
-    ];
-    PALETTE[index % PALETTE.len()]
-}
-
-fn parse_color(c: &str) -> Option<Rgba> {
-    let c = c.trim().to_ascii_lowercase();
-    if let Some(hex) = c.strip_prefix('#') {
-        if hex.len() == 6 {
-            let v = u32::from_str_radix(hex, 16).ok()?;
-            let ch = |s: u32| ((v >> s) & 0xff) as f32 / 255.0;
-            return Some([ch(16), ch(8), ch(0), 1.0]);
-        }
-        return None;
-    }
-    let rgb = match c.as_str() {
-        "red" => [0.9, 0.15, 0.15],
-        "green" => [0.2, 0.7, 0.25],
-        "blue" => [0.2, 0.4, 0.95],
-        "orange" => [1.0, 0.6, 0.1],
-        "yellow" => [0.95, 0.85, 0.15],
-        "purple" => [0.6, 0.3, 0.8],
-        "cyan" => [0.2, 0.8, 0.85],
-        "magenta" | "pink" => [0.9, 0.35, 0.7],
-        "brown" => [0.55, 0.35, 0.2],
-        "black" => [0.1, 0.1, 0.1],
-        "white" => [0.95, 0.95, 0.95],
-        "gray" | "grey" | "silver" => [0.65, 0.65, 0.7],
-        _ => return None,
-    };
-    Some([rgb[0], rgb[1], rgb[2], 1.0])
-}
+pub use crate::color::{kind_color, Rgba};
 
 fn num(out: &mut String, x: f64) {
     // Drawing needs no more than f32 (the state channel has the exact values); a non-finite
@@ -201,11 +152,19 @@ pub fn scene_update(state: &StateMsg, log_time_ns: u64, colors: &[Rgba]) -> Stri
         let d = 2.0 * state.radius.0[i];
         vec3(&mut out, [d, d, d]);
         out.push_str(",\"color\":");
-        out.push_str(
-            kind_colors
-                .get(state.kind[i] as usize)
-                .map_or("{}", String::as_str),
-        );
+        // A colour a script gave the critter wins over its kind's.
+        let own = (!state.colors.is_empty())
+            .then(|| state.colors.get(&state.id[i].to_string()))
+            .flatten()
+            .and_then(|c| crate::color::parse(c));
+        match own {
+            Some(c) => out.push_str(&color(c)),
+            None => out.push_str(
+                kind_colors
+                    .get(state.kind[i] as usize)
+                    .map_or("{}", String::as_str),
+            ),
+        }
         out.push('}');
     }
     out.push_str("],\"cylinders\":[],\"lines\":[],\"triangles\":[],\"texts\":[],\"models\":[]}]}");

@@ -6,6 +6,7 @@
 use super::keyframes::default_record_every;
 use super::schema::{FORMAT, STATE_HASH};
 use crate::scenes::Scene;
+use crate::script::profile::ProfileRow;
 use crate::script::Limits;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -300,7 +301,7 @@ impl RunMeta {
 }
 
 /// How a run ended.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct EndMeta {
     /// Steps taken.
     pub steps: u64,
@@ -310,17 +311,25 @@ pub struct EndMeta {
     pub reason: String,
     /// The final state hash.
     pub hash: u64,
+    /// The script profile (calls and time per kind and hook), when the run was profiled.
+    pub profile: Vec<ProfileRow>,
 }
 
 impl EndMeta {
     /// As an MCAP metadata map.
     pub fn to_map(&self) -> BTreeMap<String, String> {
-        BTreeMap::from([
+        let mut m = BTreeMap::from([
             ("steps".to_string(), self.steps.to_string()),
             ("outcome".to_string(), self.outcome.clone()),
             ("reason".to_string(), self.reason.clone()),
             ("hash".to_string(), format!("{:016x}", self.hash)),
-        ])
+        ]);
+        if !self.profile.is_empty() {
+            if let Ok(json) = serde_json::to_string(&self.profile) {
+                m.insert("profile".to_string(), json);
+            }
+        }
+        m
     }
 
     /// From an MCAP metadata map.
@@ -331,6 +340,10 @@ impl EndMeta {
             outcome: get("outcome"),
             reason: get("reason"),
             hash: u64::from_str_radix(&get("hash"), 16).unwrap_or(0),
+            profile: m
+                .get("profile")
+                .and_then(|p| serde_json::from_str(p).ok())
+                .unwrap_or_default(),
         }
     }
 }

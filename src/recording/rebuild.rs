@@ -148,6 +148,7 @@ fn load_script_scene(
         limits: meta.limits.clone(),
         kind_dirs: vec![kinds_dir],
         seed: meta.seed_override,
+        ..ScriptOptions::default()
     };
     // The attached scene text already has the --set values in it.
     script::load_scene(&scene_path, &[], &options).map_err(|error| RecordingError::ScriptScene {

@@ -185,10 +185,12 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
                     .get(&s.id[i].to_string())
                     .cloned()
                     .unwrap_or_default(),
+                color: s.colors.get(&s.id[i].to_string()).cloned(),
             }),
         });
     }
     w.restore(s.step, rng, critters, &free)?;
+    *w.vars_mut() = s.vars.clone();
     let impulses = s
         .contact_impulses
         .iter()

@@ -255,6 +255,14 @@ pub struct StateMsg {
     /// this state needs them to be exact. Empty under the other methods.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub quiet_steps: Vec<(u64, u16, Option<u64>)>,
+    /// The world's shared script state (`world().vars`), when it has any; it is part of the
+    /// state hash.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub vars: Props,
+    /// The colours scripts gave critters (`me.color`), by id (as a decimal string), for the
+    /// critters that have one; the others are drawn in their kind's colour.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub colors: BTreeMap<String, String>,
 }
 
 impl StateMsg {
@@ -525,7 +533,9 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
             "priority": floats_schema("collide priority"),
             "fixed": { "type": "array", "items": { "type": "boolean" } },
             "alive": { "type": "array", "items": { "type": "boolean" } },
-            "props": { "type": "object", "description": "user properties by critter id (decimal string); each value is {\"Float\": 1.5}, {\"Int\": 2}, {\"Bool\": true}, {\"Text\": \"...\"}, {\"Critter\": {\"index\", \"generation\"}}, {\"Vector\": [x, y, z]} or {\"List\": [...]}" },
+            "props": { "type": "object", "description": "user properties by critter id (decimal string); each value is {\"Float\": 1.5}, {\"Int\": 2}, {\"Bool\": true}, {\"Text\": \"...\"}, {\"Critter\": {\"index\", \"generation\"}}, {\"Vector\": [x, y, z]}, {\"List\": [...]} or {\"Map\": {name: value}}" },
+            "vars": { "type": "object", "description": "the world's shared script state (world().vars) by name, when it has any; values as in props; part of the state hash" },
+            "colors": { "type": "object", "additionalProperties": { "type": "string" }, "description": "colours scripts gave critters (me.color) by critter id (decimal string): a colour name or #rrggbb; the others have their kind's colour" },
             "walls": { "type": "array", "items": {
                 "type": "object",
                 "properties": {

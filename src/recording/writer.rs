@@ -70,6 +70,10 @@ pub struct Recorder {
     last_step: u64,
     last_state: u64,
     batch: Vec<StepRecord>,
+    /// The paths of the script files attached so far.
+    attached: std::collections::BTreeSet<String>,
+    /// How far [`Recorder::attach_since`] has read each of its caller's lists of files.
+    cursors: Vec<usize>,
 }
 
 /// Lowers the calling thread's scheduling priority (nice 10), so that on a busy machine the
@@ -171,6 +175,8 @@ impl Recorder {
             last_step: 0,
             last_state: 0,
             batch: Vec::with_capacity(BATCH),
+            attached: sources.iter().map(|s| s.path.clone()).collect(),
+            cursors: Vec::new(),
         };
         rec.capture(world, true)?;
         Ok(rec)
@@ -249,7 +255,29 @@ impl Recorder {
         if sources.is_empty() {
             return Ok(());
         }
+        self.attached.extend(sources.iter().map(|s| s.path.clone()));
         self.send(Job::Attach(sources))
+    }
+
+    /// Attaches the files a growing list of loaded scripts gained since the last call for the
+    /// same `list` (the caller's number for it), skipping paths attached already: a test's
+    /// kinds, loaded by whichever runtime spawned them. `since(n)` gives the list from its
+    /// `n`-th file on.
+    pub fn attach_since(
+        &mut self,
+        list: usize,
+        since: impl FnOnce(usize) -> Vec<SourceFile>,
+    ) -> Result<(), RecordingError> {
+        if self.cursors.len() <= list {
+            self.cursors.resize(list + 1, 0);
+        }
+        let files = since(self.cursors[list]);
+        self.cursors[list] += files.len();
+        let new: Vec<SourceFile> = files
+            .into_iter()
+            .filter(|s| !self.attached.contains(&s.path))
+            .collect();
+        self.attach(new)
     }
 
     /// Writes the final full state (if the last step was not a keyframe), the end record and the
@@ -282,6 +310,7 @@ impl Drop for Recorder {
                 outcome: "aborted".into(),
                 reason: "the recorder was dropped before the run finished".into(),
                 hash: 0,
+                ..EndMeta::default()
             };
             let _ = self.close(end);
         }
@@ -325,6 +354,7 @@ impl Output {
                     outcome: "aborted".into(),
                     reason: "the run ended without closing the recording".into(),
                     hash: 0,
+                    ..EndMeta::default()
                 })),
             };
             match job {

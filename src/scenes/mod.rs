@@ -171,6 +171,8 @@ pub struct Scene {
     /// Every script file loaded so far from the `n`-th on, kinds loaded during the run included
     /// (set for script scenes).
     pub(crate) loaded_since: Option<Box<dyn Fn(usize) -> Vec<SourceFile>>>,
+    /// The script profiler of a script scene's hooks (`run --stats`), off until turned on.
+    pub profiler: Option<std::rc::Rc<crate::script::profile::Profiler>>,
 }
 
 impl Scene {
@@ -183,6 +185,7 @@ impl Scene {
             on_step: None,
             sources: Vec::new(),
             loaded_since: None,
+            profiler: None,
         }
     }
 
@@ -193,6 +196,12 @@ impl Scene {
             Some(f) => f(n),
             None => self.sources.get(n..).map(<[_]>::to_vec).unwrap_or_default(),
         }
+    }
+
+    /// The script profile so far: calls and time per kind and hook (empty unless
+    /// `profiler` was turned on).
+    pub fn profile(&self) -> Vec<crate::script::profile::ProfileRow> {
+        self.profiler.as_ref().map(|p| p.rows()).unwrap_or_default()
     }
 
     /// One step of the world, then the scene's `on_step`. Returns the reason when the scene asks

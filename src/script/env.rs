@@ -4,7 +4,7 @@
 
 use crate::border::Topology;
 use crate::context::{Access, SpawnOrigin};
-use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::critter::{Critter, CritterId, CritterSpec, Props};
 use crate::error::Error;
 use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
@@ -58,6 +58,10 @@ pub(crate) trait Env<V: Vector> {
     fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
     /// The world itself, between steps (scene setup and `on_step`).
     fn world(&mut self) -> Option<&mut World<V>>;
+    /// The shared state `world().vars`; `None` where it is out of reach (`collides_with`).
+    fn vars(&mut self) -> Option<&mut Props> {
+        None
+    }
 }
 
 impl<V: Vector> Env<V> for World<V> {
@@ -128,6 +132,9 @@ impl<V: Vector> Env<V> for World<V> {
     fn world(&mut self) -> Option<&mut World<V>> {
         Some(self)
     }
+    fn vars(&mut self) -> Option<&mut Props> {
+        Some(self.vars_mut())
+    }
 }
 
 impl<V: Vector> Env<V> for Access<'_, V> {
@@ -185,5 +192,8 @@ impl<V: Vector> Env<V> for Access<'_, V> {
     }
     fn world(&mut self) -> Option<&mut World<V>> {
         None
+    }
+    fn vars(&mut self) -> Option<&mut Props> {
+        Some(self.vars_mut())
     }
 }

@@ -348,7 +348,9 @@ impl ScriptKind {
     #[must_use = "a hook's result says what it did"]
     fn call(&self, hook: &str, f: &HookFn, args: impl rhai::FuncArgs) -> Result<Dynamic, Error> {
         let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
-        let result = match f.scope.try_borrow_mut() {
+        // Timed per kind and hook when the profiler is on (`run --stats`, script/profile.rs).
+        let profiler = &self.rt.profiler;
+        let result = profiler.time(&self.def.name, hook, || match f.scope.try_borrow_mut() {
             Ok(mut scope) => self.rt.engine.call_fn_with_options::<Dynamic>(
                 options,
                 &mut scope,
@@ -364,7 +366,7 @@ impl ScriptKind {
                 hook,
                 args,
             ),
-        };
+        });
         result.map_err(|e| {
             let mut err = eval_error(&f.file, Some(hook), f.line, &e, self.max_ops());
             err.kind = Some(self.def.name.clone());

@@ -16,6 +16,7 @@ pub(crate) mod host;
 pub(crate) mod kind;
 pub(crate) mod kind_refs;
 pub mod lint;
+pub mod profile;
 pub(crate) mod scene;
 
 pub use lint::{check_file, check_files, FileCheck, Problem, Severity};
@@ -69,6 +70,8 @@ pub struct ScriptOptions {
     pub kind_dirs: Vec<PathBuf>,
     /// A seed that overrides the scene's own.
     pub seed: Option<u64>,
+    /// Time every hook call per kind and hook from the start ([`profile`]; `run --stats`).
+    pub profile: bool,
 }
 
 /// The engine, the kinds loaded so far, and the bridge to the world.
@@ -86,6 +89,8 @@ pub(crate) struct Runtime {
     /// Whether a kind name has a file on the kind search path, once asked (see
     /// [`Runtime::kind_exists`]).
     kind_files: RefCell<BTreeMap<String, bool>>,
+    /// Calls and time per kind and hook, when turned on.
+    pub profiler: Rc<profile::Profiler>,
 }
 
 /// What a layer above scripts adds to a runtime (the script test runner's API): functions on
@@ -123,6 +128,8 @@ impl Runtime {
                 runtime.clone(),
             ));
             host.seed_override.set(options.seed);
+            let profiler = Rc::new(profile::Profiler::default());
+            profiler.set_on(options.profile);
             Runtime {
                 engine: api::build_engine(&host, &options.limits),
                 host,
@@ -131,6 +138,7 @@ impl Runtime {
                 sources: RefCell::new(Vec::new()),
                 limits: options.limits.clone(),
                 kind_files: RefCell::new(BTreeMap::new()),
+                profiler,
             }
         })
     }

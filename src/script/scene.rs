@@ -149,6 +149,7 @@ pub(crate) fn load(
     let sources = rt.sources.borrow().clone();
     let mut scene = Scene::new(name, world, rt.host.scene_steps.get().unwrap_or(600));
     scene.sources = sources;
+    scene.profiler = Some(rt.profiler.clone());
     let loaded = rt.clone();
     scene.loaded_since = Some(Box::new(move |n| {
         loaded
@@ -189,10 +190,10 @@ impl OnStep {
             AnyWorld::D2(w) => w.step_count(),
             AnyWorld::D3(w) => w.step_count(),
         };
-        let result = match world {
+        let result = self.rt.profiler.time("scene", "on_step", || match world {
             AnyWorld::D2(w) => self.rt.host.enter::<DVec2, _>(w, run),
             AnyWorld::D3(w) => self.rt.host.enter::<DVec3, _>(w, run),
-        };
+        });
         result.map(drop).map_err(|e| {
             let mut err = eval_error(
                 &self.file,

@@ -4,8 +4,9 @@
 
 use super::run::TestRun;
 use super::world::{flat, with_scene};
+use crate::recording::keyframes::default_record_every;
 use crate::recording::{EndMeta, Recorder, Recording, RunMeta, RunOverrides, SceneSource};
-use crate::scenes::AnyWorld;
+use crate::scenes::{AnyWorld, Scene, SourceFile};
 use crate::script::api::{error, fail, Res};
 use crate::script::host::Host;
 use rhai::{Engine, EvalAltResult};
@@ -19,7 +20,42 @@ fn end_meta(world: &AnyWorld, outcome: &str, reason: String) -> EndMeta {
         outcome: outcome.into(),
         reason,
         hash: world.state_hash(),
+        ..EndMeta::default()
     }
+}
+
+/// Full states of a test's recording are at least this many steps apart: a test often starts
+/// from an empty world and spawns into it, so the scene's size at the start says nothing.
+pub const TEST_RECORD_EVERY: u64 = 30;
+
+/// The script file of test `case` (`file::name`), to attach to a world the test built itself.
+fn test_file(case: &str) -> Vec<SourceFile> {
+    let file = case.rsplit_once("::").map_or(case, |(file, _)| file);
+    std::fs::read_to_string(file).map_or_else(
+        |_| Vec::new(),
+        |text| {
+            vec![SourceFile {
+                path: file.to_string(),
+                text,
+            }]
+        },
+    )
+}
+
+/// Attaches the script files loaded since the last call: the scene's (a scene script and its
+/// kinds) and the test runtime's (kinds a test's spawn loaded).
+fn attach_loaded(host: &Host, scene: &Scene, rec: &mut Recorder) -> Res<()> {
+    rec.attach_since(0, |n| scene.sources_since(n))
+        .map_err(|e| error(e.to_string()))?;
+    let rt = host.runtime()?;
+    rec.attach_since(1, |n| {
+        rt.sources
+            .borrow()
+            .get(n..)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default()
+    })
+    .map_err(|e| error(e.to_string()))
 }
 
 /// Starts recording the test's scene, if failures are to be recorded.
@@ -30,14 +66,18 @@ pub(super) fn start(host: &Host, run: &TestRun) -> Res<()> {
     let rec = with_scene(host, |scene| {
         let overrides = RunOverrides {
             limits: run.limits.clone(),
+            record_every: Some(default_record_every(scene.world.len()).max(TEST_RECORD_EVERY)),
             ..RunOverrides::default()
         };
         let mut meta = RunMeta::for_scene(scene, &overrides);
+        let mut sources = scene.sources.clone();
         if scene.sources.is_empty() {
-            // Built by the test function itself: no scene to rebuild it from.
+            // Built by the test function itself: no scene to rebuild it from; the test's own
+            // file says how it was built.
             meta.source = SceneSource::Test { case: case.clone() };
+            sources = test_file(&case);
         }
-        Recorder::create(&path, &meta, &scene.sources, &scene.world)
+        Recorder::create(&path, &meta, &sources, &scene.world)
     })?;
     match rec {
         Ok(rec) => *run.recorder.borrow_mut() = Some(rec),
@@ -54,7 +94,9 @@ pub(super) fn start(host: &Host, run: &TestRun) -> Res<()> {
 pub(super) fn step(host: &Host, run: &TestRun) -> Res<()> {
     let mut slot = run.recorder.borrow_mut();
     if let Some(rec) = slot.as_mut() {
-        let failed = with_scene(host, |scene| rec.record(&scene.world).is_err())?;
+        let failed = with_scene(host, |scene| {
+            rec.record(&scene.world).is_err() || attach_loaded(host, scene, rec).is_err()
+        })?;
         if failed {
             *slot = None; // stop recording; the test itself goes on
         }

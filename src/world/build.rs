@@ -147,6 +147,7 @@ impl<V: Vector> State<V> {
                 health: 1.0,
                 shape: Shape::Wall(Box::new(wall)),
                 props: Default::default(),
+                color: None,
             }),
         });
         self.walls.push(id);
@@ -381,6 +382,7 @@ impl<V: Vector> State<V> {
                     props.extend(spec.props);
                     props
                 },
+                color: None,
             }),
         })
     }

@@ -36,7 +36,7 @@ pub use stats::StepStats;
 
 use crate::border::Topology;
 use crate::context::StepEvents;
-use crate::critter::{Critter, CritterId};
+use crate::critter::{Critter, CritterId, Props};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::kind::KindSet;
@@ -90,6 +90,7 @@ impl<V: Vector> World<V> {
                 step_count: 0,
                 pending: Default::default(),
                 events: StepEvents::default(),
+                vars: Props::new(),
             },
             pairs: Pairs::new(config.broad_phase),
             methods: MethodState::new(config.method, config.sleep),
@@ -210,6 +211,14 @@ impl<V: Vector> World<V> {
     /// The kinds.
     pub fn kinds(&self) -> &KindSet<V> {
         &self.state.kinds
+    }
+    /// The scripts' shared state (`world().vars`): part of the state hash when not empty.
+    pub fn vars(&self) -> &Props {
+        &self.state.vars
+    }
+    /// The scripts' shared state, to change.
+    pub fn vars_mut(&mut self) -> &mut Props {
+        &mut self.state.vars
     }
     /// What happened in the last step.
     pub fn events(&self) -> &StepEvents<V> {

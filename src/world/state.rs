@@ -4,7 +4,7 @@
 
 use crate::border::Topology;
 use crate::context::{Access, CollideCtx, CollisionEvent, Pending, StepEvents, UpdateCtx};
-use crate::critter::CritterId;
+use crate::critter::{CritterId, Props};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::kind::{KindId, KindSet};
@@ -33,6 +33,8 @@ pub(crate) struct State<V: Vector> {
     pub(crate) pending: Pending<V>,
     /// What happened in the current (or last) step.
     pub(crate) events: StepEvents<V>,
+    /// The scripts' shared state (`world().vars`), hashed when not empty.
+    pub(crate) vars: Props,
 }
 
 impl<V: Vector> State<V> {
@@ -44,6 +46,7 @@ impl<V: Vector> State<V> {
             topo: &self.topo,
             pending: &mut self.pending,
             events: &mut self.events,
+            vars: &mut self.vars,
             rng: &mut self.rng,
             step: self.step_count,
             time: self.step_count as f64 * self.dt,

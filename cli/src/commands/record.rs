@@ -119,6 +119,7 @@ pub fn finish(
         outcome: outcome.into(),
         reason: reason.into(),
         hash: scene.world.state_hash(),
+        profile: scene.profile(),
     };
     let w = rec.finish(&scene.world, end)?;
     print_written(out, &w, outcome)
@@ -143,6 +144,7 @@ pub fn fail(
         outcome: "error".into(),
         reason: message,
         hash: scene.world.state_hash(),
+        profile: scene.profile(),
     };
     let w = rec.finish(&scene.world, end)?;
     print_written(out, &w, "error")

@@ -118,9 +118,11 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         viewer.step(&scene.world, step_started.elapsed());
         let log = scene.world.log();
         if !log.is_empty() {
+            // Step k takes the world from k - 1 steps to k: the recording keeps these lines
+            // under step k too (docs/recording-format.md).
             bar.suspend(|| {
                 for line in log {
-                    eprintln!("[step {step}] {line}");
+                    eprintln!("[step {}] {line}", step + 1);
                 }
             });
         }
@@ -200,6 +202,11 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             done,
             recorder.is_some().then_some(recording),
         )?;
+        let profile = scene.profile();
+        if !profile.is_empty() {
+            writeln!(out, "scripts      calls and time per kind and hook")?;
+            write!(out, "{}", critterbox::script::profile::table(&profile))?;
+        }
     }
     let (outcome, reason) = match (&stopped, interrupted) {
         (_, true) => ("interrupted", "Ctrl-C".to_string()),
@@ -244,6 +251,7 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
     let options = ScriptOptions {
         limits: limits(args),
         seed: args.seed,
+        profile: profiled(args),
         ..ScriptOptions::default()
     };
     Ok(critterbox::script::load_scene(
@@ -251,6 +259,12 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         &sets,
         &options,
     )?)
+}
+
+/// Whether the run times its hooks (script/profile.rs): with `--stats`, whose table it feeds,
+/// and the recording's end metadata then keeps the table too.
+fn profiled(args: &RunArgs) -> bool {
+    args.stats
 }
 
 fn parse_method(s: &str) -> Result<critterbox::method::Method, String> {

@@ -174,6 +174,44 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         "must be between 0 and 1"
     ));
 
+    // The colour it is drawn in: its own (`me.color = "red"` or "#rrggbb"), else its kind's.
+    {
+        let h = host.clone();
+        engine.register_get("color", move |r: &mut CritterRef| -> Res<String> {
+            let id = r.0;
+            with_env!(h, env => match env.critter(id) {
+                Some(c) => Ok(match c.color() {
+                    Some(own) => own.to_string(),
+                    None => {
+                        let kind = env.kinds().get(c.kind());
+                        match kind.defaults.color.as_deref().filter(|k| crate::color::parse(k).is_some()) {
+                            Some(named) => named.to_string(),
+                            None => crate::color::hex(crate::color::kind_color(
+                                &kind.name,
+                                None,
+                                c.kind().0 as usize,
+                            )),
+                        }
+                    }
+                }),
+                None => Err(gone(id)),
+            })
+        });
+    }
+    critter_setter!(engine, host, "color", Dynamic, |c, v| {
+        match v
+        .clone()
+        .try_cast::<rhai::ImmutableString>()
+    {
+        Some(name) => c.set_color(Some(name.as_str())).map_err(lib_err),
+        None if v.is_unit() => c.set_color(None).map_err(lib_err),
+        None => fail(format!(
+            "color must be a string (a colour name or \"#rrggbb\"), or () for the kind's colour; got {}",
+            v.type_name()
+        )),
+    }
+    });
+
     // User properties: c["name"], and c.name when no field of that name exists.
     let h = host.clone();
     engine.register_indexer_get(move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {

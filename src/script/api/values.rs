@@ -84,8 +84,15 @@ pub(crate) fn to_prop(d: &Dynamic) -> Res<PropValue> {
             .collect::<Res<Vec<_>>>()
             .map(PropValue::List);
     }
+    if let Some(m) = d.clone().try_cast::<Map>() {
+        return m
+            .iter()
+            .map(|(k, v)| Ok((k.to_string(), to_prop(v)?)))
+            .collect::<Res<_>>()
+            .map(PropValue::Map);
+    }
     fail(format!(
-        "a critter property can be a bool, number, string, Vec, critter or array of those, not {}",
+        "a property or var can be a bool, number, string, Vec, critter, or an array or map of those, not {}",
         d.type_name()
     ))
 }
@@ -100,6 +107,11 @@ pub(crate) fn from_prop(p: &PropValue) -> Dynamic {
         PropValue::Critter(id) => Dynamic::from(CritterRef(*id)),
         PropValue::List(items) => Dynamic::from(items.iter().map(from_prop).collect::<Array>()),
         PropValue::Vector(v) => Dynamic::from(DVec3::from_array(*v)),
+        PropValue::Map(m) => Dynamic::from(
+            m.iter()
+                .map(|(k, v)| (k.as_str().into(), from_prop(v)))
+                .collect::<Map>(),
+        ),
     }
 }
 
