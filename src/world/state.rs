@@ -11,6 +11,7 @@ use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
 use crate::rules::{roles_of, roles_slots, RuleCache};
 use crate::vector::Vector;
+use crate::world::neighbours::Neighbours;
 
 /// The state a step works on (see the module docs).
 pub(crate) struct State<V: Vector> {
@@ -33,6 +34,8 @@ pub(crate) struct State<V: Vector> {
     pub(crate) pending: Pending<V>,
     /// What happened in the current (or last) step.
     pub(crate) events: StepEvents<V>,
+    /// The grid neighbour queries use, built on the first one (see `neighbours`).
+    pub(crate) neighbours: Neighbours<V>,
 }
 
 impl<V: Vector> State<V> {
@@ -45,6 +48,7 @@ impl<V: Vector> State<V> {
             pending: &mut self.pending,
             events: &mut self.events,
             rng: &mut self.rng,
+            neighbours: &mut self.neighbours,
             step: self.step_count,
             time: self.step_count as f64 * self.dt,
             dt: self.dt,
@@ -118,6 +122,8 @@ impl<V: Vector> State<V> {
         let arg_id = a.id;
         let hooks = self.kinds.get(kind).hooks.clone();
         let events_before = self.events.collisions.len();
+        // The engine moves critters between collide calls: each call starts with no grid.
+        self.neighbours.invalidate();
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,

@@ -6,6 +6,7 @@
 //! - [`critter`]: `Critter`, a handle to a critter: reading or writing its fields goes to the
 //!   world;
 //! - [`world`]: `World`, the running world: time, counts, the log (`print` and `debug` too);
+//! - [`neighbours`]: `me.nearby(r)`, `me.nearest(kind)`, `world().nearby(pos, r)`;
 //! - [`random`]: seeded randomness from the world's generator;
 //! - [`rules`]: the priority and collide-rule constants, `default_collides_with`;
 //! - [`kind_decl`]: what a kind file's top level declares (`extends`, `defaults`);
@@ -17,6 +18,7 @@
 pub(crate) mod checks;
 mod critter;
 mod kind_decl;
+mod neighbours;
 mod random;
 mod rules;
 mod scene;
@@ -89,6 +91,7 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     vec::register(&mut engine);
     critter::register(&mut engine, host);
     world::register(&mut engine, host);
+    neighbours::register(&mut engine, host);
     random::register(&mut engine, host);
     kind_decl::register(&mut engine, host);
     scene::register(&mut engine, host);
