@@ -90,7 +90,9 @@ fn hunt_alternated(_: &mut Criterion) {
         t[t.len() / 2]
     };
     let m: Vec<f64> = times.iter_mut().map(median).collect();
-    eprintln!("hunt, 5,000 prey and 50 hunters, median ms per step over {rounds} alternated rounds:");
+    eprintln!(
+        "hunt, 5,000 prey and 50 hunters, median ms per step over {rounds} alternated rounds:"
+    );
     for (k, ms) in kinds.iter().zip(&m) {
         eprintln!("  {k:10} {ms:9.3} ms");
     }

@@ -113,7 +113,8 @@ impl<V: Vector> Access<'_, V> {
             kinds: self.kinds,
             topo: self.topo,
         };
-        self.neighbours.nearest(at, centre, Filter { kind, exclude })
+        self.neighbours
+            .nearest(at, centre, Filter { kind, exclude })
     }
     /// The kinds of the world.
     pub fn kinds(&self) -> &KindSet<V> {

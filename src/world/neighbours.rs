@@ -158,10 +158,16 @@ impl<V: Vector> Neighbours<V> {
     ) -> Vec<CritterId> {
         self.ready(at);
         let mut out = Vec::new();
+        // Above this squared distance no item can be within `r` (the square root is then spared).
+        let far = r * r * (1.0 + 4.0 * f64::EPSILON) + f64::MIN_POSITIVE;
         self.visit(centre, r, |item| {
-            // A live item's position is its critter's (`settle` re-filed every move).
-            if at.topo.delta(centre, item.pos).length() <= r && passes(at, item, filter) {
-                out.push(item.id);
+            // The kind first: it is the cheapest test and the one most items fail. A live
+            // item's position is its critter's (`settle` re-filed every move).
+            if of_kind(at, item, filter) {
+                let d = at.topo.delta(centre, item.pos);
+                if d.length_squared() <= far && d.length() <= r && passes(at, item, filter) {
+                    out.push(item.id);
+                }
             }
             false
         });
@@ -180,12 +186,18 @@ impl<V: Vector> Neighbours<V> {
     ) -> Option<CritterId> {
         self.ready(at);
         let dim = V::DIM;
-        let mut reach = self.side[..dim].iter().copied().fold(f64::INFINITY, f64::min);
+        let mut reach = self.side[..dim]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
         loop {
             let mut best: Option<(f64, CritterId)> = None;
             self.visit(centre, reach, |item| {
+                if !of_kind(at, item, filter) {
+                    return false;
+                }
                 let d = at.topo.delta(centre, item.pos).length();
-                let better = best.map_or(true, |(bd, bid)| d < bd || (d == bd && item.id < bid));
+                let better = best.is_none_or(|(bd, bid)| d < bd || (d == bd && item.id < bid));
                 if better && passes(at, item, filter) {
                     best = Some((d, item.id));
                 }
@@ -226,7 +238,10 @@ impl<V: Vector> Neighbours<V> {
             self.settle(at.critters);
         }
         // Too many re-filed items (or a grid grown far past what it was sized for): rebuild.
-        if !self.valid || self.stale * 2 > self.items.len() + 64 || self.items.len() > 2 * self.built + 64 {
+        if !self.valid
+            || self.stale * 2 > self.items.len() + 64
+            || self.items.len() > 2 * self.built + 64
+        {
             self.build(at);
         }
     }
@@ -287,7 +302,11 @@ impl<V: Vector> Neighbours<V> {
             stale: true,
         };
         self.items.resize(count, blank);
-        for (c, &cell) in critters.iter_stored().filter(|c| !c.is_wall()).zip(&cell_of) {
+        for (c, &cell) in critters
+            .iter_stored()
+            .filter(|c| !c.is_wall())
+            .zip(&cell_of)
+        {
             let i = fill[cell] as usize;
             fill[cell] += 1;
             self.items[i] = Item {
@@ -365,7 +384,11 @@ impl<V: Vector> Neighbours<V> {
         let k = ((x - self.min[axis]) / self.side[axis]).floor();
         let n = self.cells[axis];
         if self.wraps {
-            let k = if k.is_finite() && k.abs() < 1e15 { k as i64 } else { 0 };
+            let k = if k.is_finite() && k.abs() < 1e15 {
+                k as i64
+            } else {
+                0
+            };
             k.rem_euclid(n)
         } else {
             k.clamp(0.0, (n - 1) as f64) as i64
@@ -389,7 +412,9 @@ impl<V: Vector> Neighbours<V> {
         let lo = ((x - reach - margin - min) / side).floor();
         let hi = ((x + reach + margin - min) / side).floor();
         if self.wraps {
-            if !(hi - lo + 1.0 < n as f64) {
+            // NaN (an infinite reach) also looks at every cell.
+            let fits = hi - lo + 1.0 < n as f64;
+            if !fits {
                 return Span::Full;
             }
             Span::Range(lo as i64, hi as i64)
@@ -447,11 +472,18 @@ impl<V: Vector> Neighbours<V> {
     }
 }
 
-/// True when the critter filed as `item` is still there, alive, and passes `filter`.
+/// True when the critter filed as `item` is of the kind `filter` asks for (or any).
+#[inline]
+fn of_kind<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
+    filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k))
+}
+
+/// True when the critter filed as `item` is still there, alive, not left out, and of the kind
+/// `filter` asks for.
 #[inline]
 fn passes<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
     filter.exclude != Some(item.id)
-        && filter.kind.map_or(true, |k| at.kinds.is_kind(item.kind, k))
+        && of_kind(at, item, filter)
         && at.critters.get(item.id).is_some_and(|c| c.alive)
 }
 
@@ -499,7 +531,9 @@ impl<V: Vector> World<V> {
         let (grid, at) = self.state.scope();
         let topo = at.topo;
         grid.any_overlapping(at, p, r, |c| {
-            !(topo.delta(c.pos, p).length() > c.radius() + r)
+            // As `!(a > b)`, so a NaN radius overlaps everything, as the scan it replaces did.
+            topo.delta(c.pos, p).length().partial_cmp(&(c.radius() + r))
+                != Some(std::cmp::Ordering::Greater)
         })
     }
 }

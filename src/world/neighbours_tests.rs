@@ -26,7 +26,8 @@ fn random_world<V: Vector>(seed: u64, n: usize, border: Border) -> World<V> {
         ..KindDefaults::default()
     };
     w.register_kind("a", None, d.clone(), Rc::new(())).unwrap();
-    w.register_kind("b", Some("a"), d.clone(), Rc::new(())).unwrap();
+    w.register_kind("b", Some("a"), d.clone(), Rc::new(()))
+        .unwrap();
     w.register_kind("c", None, d, Rc::new(())).unwrap();
     let mut rng = Rng::new(seed);
     for i in 0..n {
@@ -50,7 +51,7 @@ fn brute_nearby<V: Vector>(w: &World<V>, centre: V, r: f64, f: Filter) -> Vec<Cr
     w.critters()
         .iter()
         .filter(|c| c.alive && !c.is_wall() && f.exclude != Some(c.id))
-        .filter(|c| f.kind.map_or(true, |k| kinds.is_kind(c.kind(), k)))
+        .filter(|c| f.kind.is_none_or(|k| kinds.is_kind(c.kind(), k)))
         .filter(|c| w.topology().delta(centre, c.pos).length() <= r)
         .map(|c| c.id)
         .collect()
@@ -65,7 +66,11 @@ fn brute_nearest<V: Vector>(w: &World<V>, centre: V, f: Filter) -> Option<Critte
 }
 
 fn check_world<V: Vector>(w: &mut World<V>, rng: &mut Rng) {
-    let kinds = [None, Some(w.kinds().id("a").unwrap()), Some(w.kinds().id("b").unwrap())];
+    let kinds = [
+        None,
+        Some(w.kinds().id("a").unwrap()),
+        Some(w.kinds().id("b").unwrap()),
+    ];
     let ids: Vec<CritterId> = w.critters().iter().map(|c| c.id).collect();
     for (i, &id) in ids.iter().enumerate() {
         let Some(c) = w.get(id) else { continue };
@@ -144,7 +149,7 @@ impl KindHooks<DVec2> for Mover {
     }
     fn update(&self, ctx: &mut UpdateCtx<'_, DVec2>, _dt: f64) -> Result<(), Error> {
         let me = ctx.me().id;
-        if me.index % 3 == 0 {
+        if me.index.is_multiple_of(3) {
             let p = ctx.me().pos;
             ctx.me_mut().pos = DVec2::new(20.0 - p.y, p.x);
         }

@@ -41,7 +41,12 @@ fn kind_id<V: Vector>(env: &dyn Env<V>, kind: Option<&str>, call: &str) -> Res<O
     }
 }
 
-fn query<V: Vector>(env: &mut dyn Env<V>, from: From, kind: Option<&str>, ask: Ask) -> Res<Dynamic> {
+fn query<V: Vector>(
+    env: &mut dyn Env<V>,
+    from: From,
+    kind: Option<&str>,
+    ask: Ask,
+) -> Res<Dynamic> {
     let call = match ask {
         Ask::Nearby(_) => "nearby",
         Ask::Nearest => "nearest",
@@ -60,7 +65,9 @@ fn query<V: Vector>(env: &mut dyn Env<V>, from: From, kind: Option<&str>, ask: A
         Ask::Nearby(r) => {
             check_radius(r).or_else(fail)?;
             let ids = env.nearby(centre, r, kind, exclude).or_else(fail)?;
-            Ok(Dynamic::from_array(ids.into_iter().map(handle).collect::<Array>()))
+            Ok(Dynamic::from_array(
+                ids.into_iter().map(handle).collect::<Array>(),
+            ))
         }
         Ask::Nearest => {
             let id = env.nearest(centre, kind, exclude).or_else(fail)?;
@@ -79,9 +86,12 @@ fn radius(r: &Dynamic) -> Res<f64> {
 
 pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     let h = host.clone();
-    engine.register_fn("nearby", move |me: &mut CritterRef, r: Dynamic| -> Res<Dynamic> {
-        ask(&h, From::Me(me.0), None, Ask::Nearby(radius(&r)?))
-    });
+    engine.register_fn(
+        "nearby",
+        move |me: &mut CritterRef, r: Dynamic| -> Res<Dynamic> {
+            ask(&h, From::Me(me.0), None, Ask::Nearby(radius(&r)?))
+        },
+    );
     let h = host.clone();
     engine.register_fn(
         "nearby",
@@ -90,9 +100,12 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         },
     );
     let h = host.clone();
-    engine.register_fn("nearest", move |me: &mut CritterRef, kind: &str| -> Res<Dynamic> {
-        ask(&h, From::Me(me.0), Some(kind), Ask::Nearest)
-    });
+    engine.register_fn(
+        "nearest",
+        move |me: &mut CritterRef, kind: &str| -> Res<Dynamic> {
+            ask(&h, From::Me(me.0), Some(kind), Ask::Nearest)
+        },
+    );
     let h = host.clone();
     engine.register_fn(
         "nearby",

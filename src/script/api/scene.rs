@@ -416,9 +416,11 @@ fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) 
         // the same critters as a scan over all of them, so the same places are taken.
         let topo = *w.topology();
         let clear_of_walls = w.state.walls.iter().all(|&id| {
-            w.get(id).and_then(|c| Some((c.pos, c.wall()?))).map_or(true, |(pos, wall)| {
-                crate::contact::contact_wall_ball(wall, topo.delta(pos, p), r).is_none()
-            })
+            w.get(id)
+                .and_then(|c| Some((c.pos, c.wall()?)))
+                .is_none_or(|(pos, wall)| {
+                    crate::contact::contact_wall_ball(wall, topo.delta(pos, p), r).is_none()
+                })
         });
         let free = clear_of_walls && !w.overlaps_critter(p, r);
         if free {
