@@ -60,5 +60,63 @@ fn script_kinds(c: &mut Criterion) {
     group.finish();
 }
 
+/// The hunt scene (`scripts/scenes/hunt.rhai`) with 5,000 prey of `prey_kind` and 50 of the
+/// bench's plain hunters (`benches/kinds/hunter.rhai`).
+fn hunt(prey_kind: &str) -> critterbox::scenes::Scene {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let options = ScriptOptions {
+        kind_dirs: vec![root.join("benches/kinds"), root.join("scripts/kinds")],
+        ..ScriptOptions::default()
+    };
+    let sets = [
+        ("N_PREY", "5000"),
+        ("N_HUNTERS", "50"),
+        ("SIZE", "120.0"),
+        ("PREY_KIND", prey_kind),
+    ]
+    .map(|(k, v)| (k.to_string(), v.to_string()));
+    critterbox::script::load_scene(&root.join("scripts/scenes/hunt.rhai"), &sets, &options)
+        .expect("the hunt scene loads")
+}
+
+/// Prey fleeing the nearest hunter within 5 through `nearby` (`prey`), against the same scene
+/// with an empty `update` (`prey_idle`) and the same rule as a scan over every hunter
+/// (`prey_scan`). The three are stepped in turn, one step each per round, so load on the
+/// machine falls on all alike; the medians and ratios are printed (`docs/scripting.md`).
+fn hunt_alternated(_: &mut Criterion) {
+    use std::time::Instant;
+    let kinds = ["prey_idle", "prey", "prey_scan"];
+    let mut scenes: Vec<_> = kinds.iter().map(|k| hunt(k)).collect();
+    let rounds = 40;
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); kinds.len()];
+    for round in 0..rounds + 5 {
+        for (scene, t) in scenes.iter_mut().zip(&mut times) {
+            let start = Instant::now();
+            scene.step().expect("the hunt steps");
+            // The first rounds warm the caches and the grids up.
+            if round >= 5 {
+                t.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    let median = |t: &mut Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    };
+    let m: Vec<f64> = times.iter_mut().map(median).collect();
+    eprintln!(
+        "hunt, 5,000 prey and 50 hunters, median ms per step over {rounds} alternated rounds:"
+    );
+    for (k, ms) in kinds.iter().zip(&m) {
+        eprintln!("  {k:10} {ms:9.3} ms");
+    }
+    eprintln!(
+        "  nearby / empty update = {:.2}x; scan / nearby = {:.1}x",
+        m[1] / m[0],
+        m[2] / m[1]
+    );
+}
+
 criterion_group!(benches, script_kinds);
-criterion_main!(benches);
+criterion_group!(hunt_benches, hunt_alternated);
+criterion_main!(benches, hunt_benches);

@@ -10,6 +10,7 @@ use crate::response::{self, Hit};
 use crate::rng::Rng;
 use crate::vector::Vector;
 use crate::world::OnOverlap;
+use crate::world::neighbours::{Filter, Neighbours, Scope};
 use std::ops::{Deref, DerefMut};
 
 /// A collision that happened in a step.
@@ -124,6 +125,7 @@ pub struct Access<'a, V: Vector> {
     pub(crate) events: &'a mut StepEvents<V>,
     pub(crate) vars: &'a mut Props,
     pub(crate) rng: &'a mut Rng,
+    pub(crate) neighbours: &'a mut Neighbours<V>,
     pub(crate) step: u64,
     pub(crate) time: f64,
     pub(crate) dt: f64,
@@ -136,7 +138,42 @@ impl<V: Vector> Access<'_, V> {
     }
     /// The critter `id`, mutably.
     pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.neighbours.moved(id);
         self.critters.get_mut(id)
+    }
+    /// Live critters other than walls whose centres lie within `r` of `centre` (through the
+    /// border when it wraps), of `kind` or a kind extending it when given, leaving out
+    /// `exclude`, in id order. Looks only at the grid cells the ball overlaps.
+    pub fn nearby(
+        &mut self,
+        centre: V,
+        r: f64,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Vec<CritterId> {
+        let at = Scope {
+            critters: self.critters,
+            kinds: self.kinds,
+            topo: self.topo,
+        };
+        self.neighbours
+            .nearby(at, centre, r, Filter { kind, exclude })
+    }
+    /// The live critter other than walls nearest to `centre`, of `kind` (or a kind extending
+    /// it) when given, leaving out `exclude`; ties go to the lower id.
+    pub fn nearest(
+        &mut self,
+        centre: V,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Option<CritterId> {
+        let at = Scope {
+            critters: self.critters,
+            kinds: self.kinds,
+            topo: self.topo,
+        };
+        self.neighbours
+            .nearest(at, centre, Filter { kind, exclude })
     }
     /// The kinds of the world.
     pub fn kinds(&self) -> &KindSet<V> {
@@ -259,6 +296,8 @@ impl<V: Vector> Access<'_, V> {
         }
         let (a, b) = (self.critters.slot_of(caller)?, self.critters.slot_of(arg)?);
         let topo = self.topo;
+        self.neighbours.moved(caller);
+        self.neighbours.moved(arg);
         let (me, other) = self.critters.pair_mut_moving(a, b);
         let hit = response::collide_default(topo, me, other)?;
         self.events.collisions.push(CollisionEvent {
@@ -309,6 +348,11 @@ impl<V: Vector> CollideCtx<'_, V> {
     }
     /// Both, mutably: (me, other).
     pub fn both_mut(&mut self) -> (&mut Critter<V>, &mut Critter<V>) {
+        if self.access.neighbours.is_tracking() {
+            let (me, other) = (self.me().id, self.other().id);
+            self.access.neighbours.moved(me);
+            self.access.neighbours.moved(other);
+        }
         self.access.critters.pair_mut(self.me, self.other)
     }
     /// The caller, mutably.
@@ -381,6 +425,10 @@ impl<V: Vector> UpdateCtx<'_, V> {
     }
     /// The critter being updated, mutably.
     pub fn me_mut(&mut self) -> &mut Critter<V> {
+        if self.access.neighbours.is_tracking() {
+            let id = self.me().id;
+            self.access.neighbours.moved(id);
+        }
         self.access
             .critters
             .slot_mut(self.me)

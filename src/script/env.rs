@@ -62,7 +62,29 @@ pub(crate) trait Env<V: Vector> {
     fn vars(&mut self) -> Option<&mut Props> {
         None
     }
+    /// Neighbour queries (see `world::neighbours`); `Err` where the world is read-only.
+    fn nearby(
+        &mut self,
+        _centre: V,
+        _r: f64,
+        _kind: Option<KindId>,
+        _exclude: Option<CritterId>,
+    ) -> Result<Vec<CritterId>, String> {
+        Err(NO_QUERIES.into())
+    }
+    fn nearest(
+        &mut self,
+        _centre: V,
+        _kind: Option<KindId>,
+        _exclude: Option<CritterId>,
+    ) -> Result<Option<CritterId>, String> {
+        Err(NO_QUERIES.into())
+    }
 }
+
+/// Why `collides_with` cannot ask for neighbours.
+const NO_QUERIES: &str =
+    "nearby and nearest work in update, init and collide hooks and in scenes, not in collides_with";
 
 impl<V: Vector> Env<V> for World<V> {
     fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
@@ -135,6 +157,23 @@ impl<V: Vector> Env<V> for World<V> {
     fn vars(&mut self) -> Option<&mut Props> {
         Some(self.vars_mut())
     }
+    fn nearby(
+        &mut self,
+        centre: V,
+        r: f64,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Result<Vec<CritterId>, String> {
+        Ok(World::nearby(self, centre, r, kind, exclude))
+    }
+    fn nearest(
+        &mut self,
+        centre: V,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Result<Option<CritterId>, String> {
+        Ok(World::nearest(self, centre, kind, exclude))
+    }
 }
 
 impl<V: Vector> Env<V> for Access<'_, V> {
@@ -195,5 +234,22 @@ impl<V: Vector> Env<V> for Access<'_, V> {
     }
     fn vars(&mut self) -> Option<&mut Props> {
         Some(self.vars_mut())
+    }
+    fn nearby(
+        &mut self,
+        centre: V,
+        r: f64,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Result<Vec<CritterId>, String> {
+        Ok(Access::nearby(self, centre, r, kind, exclude))
+    }
+    fn nearest(
+        &mut self,
+        centre: V,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Result<Option<CritterId>, String> {
+        Ok(Access::nearest(self, centre, kind, exclude))
     }
 }

@@ -159,6 +159,7 @@ impl<V: Vector> State<V> {
         let critter = self.build(spec)?;
         let has_init = self.kinds.get(critter.kind()).has_init;
         let id = self.critters.insert(|id| Critter { id, ..critter });
+        self.neighbours.moved(id);
         if has_init {
             self.run_init(id)?;
         }

@@ -19,6 +19,7 @@ mod build;
 mod config;
 mod diagnostics;
 mod layout;
+pub(crate) mod neighbours;
 mod restore;
 pub(crate) mod stages;
 pub(crate) mod state;
@@ -91,6 +92,7 @@ impl<V: Vector> World<V> {
                 pending: Default::default(),
                 events: StepEvents::default(),
                 vars: Props::new(),
+                neighbours: Default::default(),
             },
             pairs: Pairs::new(config.broad_phase),
             methods: MethodState::new(config.method, config.sleep),
@@ -206,6 +208,7 @@ impl<V: Vector> World<V> {
     }
     /// Critter `id`, mutably.
     pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
+        self.state.neighbours.moved(id);
         self.state.critters.get_mut(id)
     }
     /// The kinds.

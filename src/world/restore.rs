@@ -48,6 +48,7 @@ impl<V: Vector> World<V> {
         let set = CritterSet::from_parts(all, free)
             .ok_or_else(|| "the state's slots contradict each other".to_string())?;
         state.critters = set;
+        state.neighbours.invalidate();
         state.walls = kept;
         state.rng = Rng::from_state(rng);
         state.step_count = step;

@@ -11,6 +11,7 @@ use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
 use crate::rules::{roles_of, roles_slots, RuleCache};
 use crate::vector::Vector;
+use crate::world::neighbours::Neighbours;
 
 /// The state a step works on (see the module docs).
 pub(crate) struct State<V: Vector> {
@@ -35,6 +36,8 @@ pub(crate) struct State<V: Vector> {
     pub(crate) events: StepEvents<V>,
     /// The scripts' shared state (`world().vars`), hashed when not empty.
     pub(crate) vars: Props,
+    /// The grid neighbour queries use, built on the first one (see `neighbours`).
+    pub(crate) neighbours: Neighbours<V>,
 }
 
 impl<V: Vector> State<V> {
@@ -48,6 +51,7 @@ impl<V: Vector> State<V> {
             events: &mut self.events,
             vars: &mut self.vars,
             rng: &mut self.rng,
+            neighbours: &mut self.neighbours,
             step: self.step_count,
             time: self.step_count as f64 * self.dt,
             dt: self.dt,
@@ -121,6 +125,8 @@ impl<V: Vector> State<V> {
         let arg_id = a.id;
         let hooks = self.kinds.get(kind).hooks.clone();
         let events_before = self.events.collisions.len();
+        // The engine moves critters between collide calls: each call starts with no grid.
+        self.neighbours.invalidate();
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,

@@ -17,7 +17,10 @@ impl<V: Vector> World<V> {
         self.stats = StepStats::default();
         let mut stats = StepStats::default();
 
+        // Neighbour grids live within a stage: the engine moves critters between stages.
+        self.state.neighbours.invalidate();
         timed(&mut stats.update, || update::run(&mut self.state))?;
+        self.state.neighbours.invalidate();
         let plan = self.methods.plan(&self.state);
         // The layout is for the broad phase's sake, which rebuilds its list after one.
         let allowed = self.methods.allows_layout(&plan);
@@ -27,6 +30,7 @@ impl<V: Vector> World<V> {
         });
         self.methods
             .step(plan, &mut self.state, &mut self.pairs, &mut stats)?;
+        self.state.neighbours.invalidate();
         timed(&mut stats.lifecycle, || {
             lifecycle::run(&mut self.state, &mut self.methods)
         })?;

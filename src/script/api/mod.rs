@@ -7,6 +7,7 @@
 //!   world;
 //! - [`world`]: `World`, the running world: time, counts, the log (`print` and `debug` too);
 //! - [`vars`]: `world().vars`, the state a scene, its kinds and its tests share;
+//! - [`neighbours`]: `me.nearby(r)`, `me.nearest(kind)`, `world().nearby(pos, r)`;
 //! - [`random`]: seeded randomness from the world's generator;
 //! - [`rules`]: the priority and collide-rule constants, `default_collides_with`;
 //! - [`kind_decl`]: what a kind file's top level declares (`extends`, `defaults`);
@@ -18,6 +19,7 @@
 pub(crate) mod checks;
 mod critter;
 mod kind_decl;
+mod neighbours;
 mod random;
 mod rules;
 mod scene;
@@ -92,6 +94,7 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     critter::register(&mut engine, host);
     world::register(&mut engine, host);
     vars::register(&mut engine, host);
+    neighbours::register(&mut engine, host);
     random::register(&mut engine, host);
     kind_decl::register(&mut engine, host);
     scene::register(&mut engine, host);

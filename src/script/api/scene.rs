@@ -417,13 +417,17 @@ fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) 
         for axis in 0..V::DIM {
             p.set(axis, w.rng().uniform(min.get(axis) + r, max.get(axis) - r));
         }
-        let free = w.critters().iter().all(|c| {
-            let d = w.topology().delta(c.pos, p);
-            match c.wall() {
-                Some(wall) => crate::contact::contact_wall_ball(wall, d, r).is_none(),
-                None => d.length() > c.radius() + r,
-            }
+        // Walls one by one (they are few), disks through the neighbour grid: the same test on
+        // the same critters as a scan over all of them, so the same places are taken.
+        let topo = *w.topology();
+        let clear_of_walls = w.state.walls.iter().all(|&id| {
+            w.get(id)
+                .and_then(|c| Some((c.pos, c.wall()?)))
+                .is_none_or(|(pos, wall)| {
+                    crate::contact::contact_wall_ball(wall, topo.delta(pos, p), r).is_none()
+                })
         });
+        let free = clear_of_walls && !w.overlaps_critter(p, r);
         if free {
             let mut m = map.clone();
             m.insert("pos".into(), Dynamic::from(to_svec(p)));

@@ -1,0 +1,543 @@
+//! Neighbour queries (`me.nearby(r)`, `me.nearest(kind)`, `world().nearby(pos, r)`, and the
+//! free-place test of `w.scatter`): a uniform grid of the critters' centres, built on the first
+//! query and kept while nothing the engine cannot see moves the critters.
+//!
+//! The broad phase's grid is built in the pairs stage, after the move, so `update` hooks would
+//! see it stale; this grid is built from the positions of the moment. Every hook write to a
+//! critter ([`Neighbours::moved`]) and every spawn is noted; the next query re-files the noted
+//! critters whose centre (or radius) changed, so answers are exact for the current positions.
+//! The world drops the grid where the engine itself moves critters (each step's start, after
+//! the update stage, before each `collide` call, before the lifecycle, on restore).
+//!
+//! A query looks at the cells its ball overlaps and the critters in them, never at every
+//! critter. Results are in id order and `nearest` breaks ties by the lower id, so the answers do
+//! not depend on where critters are stored or how the grid was built.
+
+use crate::border::Topology;
+use crate::critter::{Critter, CritterId};
+use crate::critter_set::CritterSet;
+use crate::kind::{KindId, KindSet};
+use crate::tolerance::ROUNDING_MARGIN;
+use crate::vector::Vector;
+use crate::world::state::State;
+use crate::world::World;
+
+/// No item (end of a cell's list, or an id index with no item).
+const NONE: u32 = u32::MAX;
+
+/// A critter as the grid filed it.
+#[derive(Clone, Copy, Debug)]
+struct Item<V> {
+    id: CritterId,
+    pos: V,
+    radius: f64,
+    kind: KindId,
+    /// The critter was re-filed under a newer item (it moved, or its id index was reused).
+    stale: bool,
+}
+
+/// The neighbour grid of a world (see the module docs).
+#[derive(Clone, Debug)]
+pub(crate) struct Neighbours<V: Vector> {
+    valid: bool,
+    /// Cells per axis (1 on axes the dimension lacks).
+    cells: [i64; 3],
+    /// Cell side per axis.
+    side: [f64; 3],
+    min: [f64; 3],
+    wraps: bool,
+    /// By cell (x fastest), its first item.
+    head: Vec<u32>,
+    /// By item, the next item of its cell.
+    next: Vec<u32>,
+    items: Vec<Item<V>>,
+    /// By id index, its critter's current item.
+    home: Vec<u32>,
+    /// Critters a hook may have moved since the last query (only while the grid is valid).
+    touched: Vec<CritterId>,
+    /// Items at the last build, and stale items since.
+    built: usize,
+    stale: usize,
+    /// Largest radius of an item at the last build (items filed since are re-filed critters,
+    /// whose radius `max_radius` also covers).
+    max_radius: f64,
+    /// How many times the grid was built (tests check it is once per stage).
+    builds: u64,
+}
+
+impl<V: Vector> Default for Neighbours<V> {
+    fn default() -> Self {
+        Neighbours {
+            valid: false,
+            cells: [1; 3],
+            side: [1.0; 3],
+            min: [0.0; 3],
+            wraps: false,
+            head: Vec::new(),
+            next: Vec::new(),
+            items: Vec::new(),
+            home: Vec::new(),
+            touched: Vec::new(),
+            built: 0,
+            stale: 0,
+            max_radius: 0.0,
+            builds: 0,
+        }
+    }
+}
+
+/// The read-only world a query looks at.
+#[derive(Clone, Copy)]
+pub(crate) struct Scope<'a, V: Vector> {
+    pub critters: &'a CritterSet<V>,
+    pub kinds: &'a KindSet<V>,
+    pub topo: &'a Topology<V>,
+}
+
+/// What `nearby` and `nearest` keep: the kind the answers must be (or extend), and the critter
+/// they leave out (the asker).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Filter {
+    pub kind: Option<KindId>,
+    pub exclude: Option<CritterId>,
+}
+
+/// Checks a query radius: a number >= 0 (infinity is every critter).
+pub(crate) fn check_radius(r: f64) -> Result<(), String> {
+    if r >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("nearby radius {r}: it must be a number >= 0"))
+    }
+}
+
+/// The cells along one axis a query looks at: `Full` (all of them), or `lo..=hi` (wrapped
+/// modulo the count when the border wraps, so `lo` may be negative).
+#[derive(Clone, Copy)]
+enum Span {
+    Full,
+    Range(i64, i64),
+}
+
+impl<V: Vector> Neighbours<V> {
+    /// Drops the grid: the engine moved critters where the grid cannot see.
+    #[inline]
+    pub(crate) fn invalidate(&mut self) {
+        self.valid = false;
+        self.touched.clear();
+    }
+
+    /// Notes that critter `id` may have moved (a write through a hook's or the scene's handle).
+    #[inline]
+    pub(crate) fn moved(&mut self, id: CritterId) {
+        if self.valid {
+            self.touched.push(id);
+        }
+    }
+
+    /// True while writes are noted (the grid is built).
+    #[inline]
+    pub(crate) fn is_tracking(&self) -> bool {
+        self.valid
+    }
+
+    /// How many times the grid has been built.
+    #[cfg(test)]
+    pub(crate) fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// The live critters other than walls within `r` of `centre` (through the border when it
+    /// wraps) that pass `filter`, in id order.
+    pub(crate) fn nearby(
+        &mut self,
+        at: Scope<'_, V>,
+        centre: V,
+        r: f64,
+        filter: Filter,
+    ) -> Vec<CritterId> {
+        self.ready(at);
+        let mut out = Vec::new();
+        // Above this squared distance no item can be within `r` (the square root is then spared).
+        let far = r * r * (1.0 + 4.0 * f64::EPSILON) + f64::MIN_POSITIVE;
+        self.visit(centre, r, |item| {
+            // The kind first: it is the cheapest test and the one most items fail. A live
+            // item's position is its critter's (`settle` re-filed every move).
+            if of_kind(at, item, filter) {
+                let d = at.topo.delta(centre, item.pos);
+                if d.length_squared() <= far && d.length() <= r && passes(at, item, filter) {
+                    out.push(item.id);
+                }
+            }
+            false
+        });
+        out.sort_unstable();
+        out
+    }
+
+    /// The live critter other than walls nearest to `centre` that passes `filter` (ties go to
+    /// the lower id), or `None`. The ball searched doubles until it holds an answer or covers
+    /// the grid.
+    pub(crate) fn nearest(
+        &mut self,
+        at: Scope<'_, V>,
+        centre: V,
+        filter: Filter,
+    ) -> Option<CritterId> {
+        self.ready(at);
+        let dim = V::DIM;
+        let mut reach = self.side[..dim]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        loop {
+            let mut best: Option<(f64, CritterId)> = None;
+            self.visit(centre, reach, |item| {
+                if !of_kind(at, item, filter) {
+                    return false;
+                }
+                let d = at.topo.delta(centre, item.pos).length();
+                let better = best.is_none_or(|(bd, bid)| d < bd || (d == bd && item.id < bid));
+                if better && passes(at, item, filter) {
+                    best = Some((d, item.id));
+                }
+                false
+            });
+            // Every critter within `reach` was looked at; a nearer one than `best` would be too.
+            match best {
+                Some((d, id)) if d <= reach => return Some(id),
+                _ if self.covers_all(centre, reach) => return best.map(|(_, id)| id),
+                _ => reach *= 2.0,
+            }
+        }
+    }
+
+    /// True when some critter (live or dying, not a wall) satisfies `hit`, among those whose
+    /// centre lies within `reach + r` of `centre`, `r` being the largest radius in the grid:
+    /// `w.scatter`'s overlap test, which `hit` makes exactly.
+    pub(crate) fn any_overlapping(
+        &mut self,
+        at: Scope<'_, V>,
+        centre: V,
+        reach: f64,
+        mut hit: impl FnMut(&Critter<V>) -> bool,
+    ) -> bool {
+        self.ready(at);
+        let reach = reach + self.max_radius;
+        let mut found = false;
+        self.visit(centre, reach, |item| {
+            found = at.critters.get(item.id).is_some_and(&mut hit);
+            found
+        });
+        found
+    }
+
+    /// Builds the grid if it is not valid, and re-files the critters noted since the last query.
+    fn ready(&mut self, at: Scope<'_, V>) {
+        if self.valid {
+            self.settle(at.critters);
+        }
+        // Too many re-filed items (or a grid grown far past what it was sized for): rebuild.
+        if !self.valid
+            || self.stale * 2 > self.items.len() + 64
+            || self.items.len() > 2 * self.built + 64
+        {
+            self.build(at);
+        }
+    }
+
+    fn build(&mut self, at: Scope<'_, V>) {
+        self.builds += 1;
+        let (topo, critters) = (at.topo, at.critters);
+        let dim = V::DIM;
+        let count = critters.iter_stored().filter(|c| !c.is_wall()).count();
+        let size = topo.size();
+        let volume: f64 = (0..dim).map(|a| size.get(a)).product();
+        // About two critters a cell.
+        let target = (count / 2).max(1) as f64;
+        let side = (volume / target).powf(1.0 / dim as f64);
+        self.wraps = topo.wraps();
+        self.cells = [1; 3];
+        self.side = [1.0; 3];
+        self.min = [0.0; 3];
+        for a in 0..dim {
+            let l = size.get(a);
+            let n = if side > 0.0 && side.is_finite() {
+                (l / side).floor().clamp(1.0, 4096.0) as i64
+            } else {
+                1
+            };
+            self.cells[a] = n;
+            self.side[a] = l / n as f64;
+            self.min[a] = topo.min.get(a);
+        }
+        let ncells = (self.cells[0] * self.cells[1] * self.cells[2]) as usize;
+
+        // Counting sort by cell, so each cell's items lie together in memory.
+        self.items.clear();
+        self.next.clear();
+        self.home.clear();
+        self.home.resize(critters.index_count(), NONE);
+        let mut start = vec![0u32; ncells + 1];
+        let mut cell_of = Vec::with_capacity(count);
+        let mut max_radius: f64 = 0.0;
+        for c in critters.iter_stored().filter(|c| !c.is_wall()) {
+            let cell = self.cell(c.pos);
+            start[cell + 1] += 1;
+            cell_of.push(cell);
+            max_radius = max_radius.max(c.radius);
+        }
+        for i in 0..ncells {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let blank = Item {
+            id: CritterId {
+                index: NONE,
+                generation: 0,
+            },
+            pos: V::zero(),
+            radius: 0.0,
+            kind: crate::kind::WALL,
+            stale: true,
+        };
+        self.items.resize(count, blank);
+        for (c, &cell) in critters
+            .iter_stored()
+            .filter(|c| !c.is_wall())
+            .zip(&cell_of)
+        {
+            let i = fill[cell] as usize;
+            fill[cell] += 1;
+            self.items[i] = Item {
+                id: c.id,
+                pos: c.pos,
+                radius: c.radius,
+                kind: c.kind(),
+                stale: false,
+            };
+            self.home[c.id.index as usize] = i as u32;
+        }
+        self.next.resize(count, NONE);
+        self.head.clear();
+        self.head.resize(ncells, NONE);
+        for cell in 0..ncells {
+            let (a, b) = (start[cell] as usize, start[cell + 1] as usize);
+            if a < b {
+                self.head[cell] = a as u32;
+                for i in a..b - 1 {
+                    self.next[i] = i as u32 + 1;
+                }
+            }
+        }
+        self.built = count;
+        self.stale = 0;
+        self.max_radius = max_radius;
+        self.touched.clear();
+        self.valid = true;
+    }
+
+    /// Re-files the noted critters whose centre or radius changed, and files new ones.
+    fn settle(&mut self, critters: &CritterSet<V>) {
+        let touched = std::mem::take(&mut self.touched);
+        for &id in &touched {
+            let Some(c) = critters.get(id) else {
+                continue; // gone: its item is skipped by every query
+            };
+            if c.is_wall() {
+                continue;
+            }
+            let index = id.index as usize;
+            if index >= self.home.len() {
+                self.home.resize(index + 1, NONE);
+            }
+            let h = self.home[index];
+            if h != NONE {
+                let item = &mut self.items[h as usize];
+                if item.id == id && item.pos == c.pos && item.radius == c.radius {
+                    continue;
+                }
+                item.stale = true;
+                self.stale += 1;
+            }
+            let cell = self.cell(c.pos);
+            let i = self.items.len() as u32;
+            self.items.push(Item {
+                id,
+                pos: c.pos,
+                radius: c.radius,
+                kind: c.kind(),
+                stale: false,
+            });
+            self.next.push(self.head[cell]);
+            self.head[cell] = i;
+            self.home[index] = i;
+            self.max_radius = self.max_radius.max(c.radius);
+        }
+        self.touched = touched;
+        self.touched.clear();
+    }
+
+    /// The cell coordinate of `x` along `axis` (wrapped, or clamped to the grid).
+    #[inline]
+    fn coord(&self, axis: usize, x: f64) -> i64 {
+        let k = ((x - self.min[axis]) / self.side[axis]).floor();
+        let n = self.cells[axis];
+        if self.wraps {
+            let k = if k.is_finite() && k.abs() < 1e15 {
+                k as i64
+            } else {
+                0
+            };
+            k.rem_euclid(n)
+        } else {
+            k.clamp(0.0, (n - 1) as f64) as i64
+        }
+    }
+
+    #[inline]
+    fn cell(&self, p: V) -> usize {
+        let mut cell = 0i64;
+        for a in (0..V::DIM).rev() {
+            cell = cell * self.cells[a] + self.coord(a, p.get(a));
+        }
+        cell as usize
+    }
+
+    /// The cells along `axis` within `reach` of `x`, widened by a rounding margin.
+    fn span(&self, axis: usize, x: f64, reach: f64) -> Span {
+        let n = self.cells[axis];
+        let (min, side) = (self.min[axis], self.side[axis]);
+        let margin = ROUNDING_MARGIN * (min.abs() + side * n as f64 + x.abs() + reach);
+        let lo = ((x - reach - margin - min) / side).floor();
+        let hi = ((x + reach + margin - min) / side).floor();
+        if self.wraps {
+            // NaN (an infinite reach) also looks at every cell.
+            let fits = hi - lo + 1.0 < n as f64;
+            if !fits {
+                return Span::Full;
+            }
+            Span::Range(lo as i64, hi as i64)
+        } else {
+            if !(lo > 0.0 || hi < (n - 1) as f64) {
+                return Span::Full;
+            }
+            let clamp = |k: f64| k.clamp(0.0, (n - 1) as f64) as i64;
+            Span::Range(clamp(lo), clamp(hi))
+        }
+    }
+
+    /// True when a query of `reach` around `centre` looks at every cell.
+    fn covers_all(&self, centre: V, reach: f64) -> bool {
+        (0..V::DIM).all(|a| matches!(self.span(a, centre.get(a), reach), Span::Full))
+    }
+
+    /// Calls `f` on each live item in the cells within `reach` of `centre` until `f` returns
+    /// true.
+    fn visit(&self, centre: V, reach: f64, mut f: impl FnMut(&Item<V>) -> bool) {
+        let mut spans = [Span::Range(0, 0); 3];
+        for (a, span) in spans.iter_mut().enumerate().take(V::DIM) {
+            *span = self.span(a, centre.get(a), reach);
+        }
+        let range = |a: usize| match spans[a] {
+            Span::Full => (0, self.cells[a] - 1),
+            Span::Range(lo, hi) => (lo, hi),
+        };
+        let wrap = |a: usize, k: i64| {
+            if self.wraps {
+                k.rem_euclid(self.cells[a])
+            } else {
+                k
+            }
+        };
+        let (x0, x1) = range(0);
+        let (y0, y1) = range(1);
+        let (z0, z1) = range(2);
+        for z in z0..=z1 {
+            let zc = wrap(2, z);
+            for y in y0..=y1 {
+                let row = (zc * self.cells[1] + wrap(1, y)) * self.cells[0];
+                for x in x0..=x1 {
+                    let mut i = self.head[(row + wrap(0, x)) as usize];
+                    while i != NONE {
+                        let item = &self.items[i as usize];
+                        i = self.next[i as usize];
+                        if !item.stale && f(item) {
+                            return;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// True when the critter filed as `item` is of the kind `filter` asks for (or any).
+#[inline]
+fn of_kind<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
+    filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k))
+}
+
+/// True when the critter filed as `item` is still there, alive, not left out, and of the kind
+/// `filter` asks for.
+#[inline]
+fn passes<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
+    filter.exclude != Some(item.id)
+        && of_kind(at, item, filter)
+        && at.critters.get(item.id).is_some_and(|c| c.alive)
+}
+
+impl<V: Vector> State<V> {
+    fn scope(&mut self) -> (&mut Neighbours<V>, Scope<'_, V>) {
+        let at = Scope {
+            critters: &self.critters,
+            kinds: &self.kinds,
+            topo: &self.topo,
+        };
+        (&mut self.neighbours, at)
+    }
+}
+
+impl<V: Vector> World<V> {
+    /// Live critters other than walls whose centres lie within `r` of `centre` (through the
+    /// border when it wraps), of `kind` or a kind extending it when given, leaving out
+    /// `exclude`, in id order. Looks only at the grid cells the ball overlaps.
+    pub fn nearby(
+        &mut self,
+        centre: V,
+        r: f64,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Vec<CritterId> {
+        let (grid, at) = self.state.scope();
+        grid.nearby(at, centre, r, Filter { kind, exclude })
+    }
+
+    /// The live critter other than walls nearest to `centre`, of `kind` (or a kind extending
+    /// it) when given, leaving out `exclude`; ties go to the lower id.
+    pub fn nearest(
+        &mut self,
+        centre: V,
+        kind: Option<KindId>,
+        exclude: Option<CritterId>,
+    ) -> Option<CritterId> {
+        let (grid, at) = self.state.scope();
+        grid.nearest(at, centre, Filter { kind, exclude })
+    }
+
+    /// True when a disk of radius `r` at `p` would overlap a critter other than a wall (live
+    /// or dying): `w.scatter`'s test, not `|delta| > r + radius`, asked only of nearby critters.
+    pub(crate) fn overlaps_critter(&mut self, p: V, r: f64) -> bool {
+        let (grid, at) = self.state.scope();
+        let topo = at.topo;
+        grid.any_overlapping(at, p, r, |c| {
+            // As `!(a > b)`, so a NaN radius overlaps everything, as the scan it replaces did.
+            topo.delta(c.pos, p).length().partial_cmp(&(c.radius() + r))
+                != Some(std::cmp::Ordering::Greater)
+        })
+    }
+}
+
+#[cfg(test)]
+#[path = "neighbours_tests.rs"]
+mod tests;
