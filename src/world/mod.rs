@@ -16,6 +16,7 @@
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
 mod build;
+pub(crate) mod births;
 mod config;
 mod diagnostics;
 mod layout;
@@ -25,6 +26,7 @@ pub(crate) mod state;
 mod state_hash;
 pub(crate) mod stats;
 mod step;
+pub(crate) mod touch;
 #[cfg(test)]
 mod tests;
 
@@ -89,6 +91,8 @@ impl<V: Vector> World<V> {
                 step_count: 0,
                 pending: Default::default(),
                 events: StepEvents::default(),
+                births: Default::default(),
+                touch: Default::default(),
             },
             pairs: Pairs::new(config.broad_phase),
             methods: MethodState::new(config.method, config.sleep),
@@ -258,6 +262,12 @@ impl<V: Vector> World<V> {
     /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
         crate::hash::critters::totals(self.state.critters.in_id_order()).1
+    }
+    /// Seconds of simulated time since critter `id` was spawned: the steps begun since then
+    /// times dt (0 in its `init`).
+    pub fn age(&self, id: CritterId) -> Option<f64> {
+        self.state.critters.get(id)?;
+        Some(self.state.births.age(id, self.state.step_count, self.state.dt))
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {

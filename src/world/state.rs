@@ -33,6 +33,10 @@ pub(crate) struct State<V: Vector> {
     pub(crate) pending: Pending<V>,
     /// What happened in the current (or last) step.
     pub(crate) events: StepEvents<V>,
+    /// The step each critter was spawned at (for `age`).
+    pub(crate) births: super::births::Births,
+    /// The touching spells, kept when some kind tracks them.
+    pub(crate) touch: super::touch::Spells<V>,
 }
 
 impl<V: Vector> State<V> {
@@ -44,6 +48,7 @@ impl<V: Vector> State<V> {
             topo: &self.topo,
             pending: &mut self.pending,
             events: &mut self.events,
+            births: &self.births,
             rng: &mut self.rng,
             step: self.step_count,
             time: self.step_count as f64 * self.dt,
@@ -67,6 +72,28 @@ impl<V: Vector> State<V> {
         };
         hooks
             .init(&mut ctx)
+            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+    }
+
+    /// Runs critter `id`'s `on_death` hook, if its kind has one.
+    pub(crate) fn run_on_death(&mut self, id: CritterId) -> Result<(), Error> {
+        let step = self.step_count;
+        let Some(me) = self.critters.slot_of(id) else {
+            return Ok(());
+        };
+        let Some(kind) = self.critters.slot(me).map(|c| c.kind()) else {
+            return Ok(());
+        };
+        if !self.kinds.get(kind).has_on_death {
+            return Ok(());
+        }
+        let hooks = self.kinds.get(kind).hooks.clone();
+        let mut ctx = UpdateCtx {
+            access: self.access(),
+            me,
+        };
+        hooks
+            .on_death(&mut ctx)
             .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
     }
 
@@ -118,10 +145,12 @@ impl<V: Vector> State<V> {
         let arg_id = a.id;
         let hooks = self.kinds.get(kind).hooks.clone();
         let events_before = self.events.collisions.len();
+        let first = self.kinds.tracks_touch() && self.note_touch(caller, arg);
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,
             other: arg,
+            first,
         };
         let handled = hooks
             .collide(&mut ctx)

@@ -8,6 +8,7 @@
 //! - [`world`]: `World`, the running world: time, counts, the log (`print` and `debug` too);
 //! - [`random`]: seeded randomness from the world's generator;
 //! - [`rules`]: the priority and collide-rule constants, `default_collides_with`;
+//! - [`hooks`]: `Contact`, the `parent_*` calls, `me.age`;
 //! - [`kind_decl`]: what a kind file's top level declares (`extends`, `defaults`);
 //! - [`scene`]: building a scene's world: `world(#{ ... })`, walls, spawning patterns, `spawn`.
 //!
@@ -16,6 +17,7 @@
 
 pub(crate) mod checks;
 mod critter;
+mod hooks;
 mod kind_decl;
 mod random;
 mod rules;
@@ -27,6 +29,7 @@ mod vec;
 mod world;
 
 pub(crate) use critter::CritterRef;
+pub(crate) use hooks::ScriptContact;
 pub(crate) use rules::{rule_code, rule_of_code};
 pub(crate) use values::{num_or, props_from_map};
 pub(crate) use world::WorldRef;
@@ -88,6 +91,7 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     rules::register(&mut engine, host);
     vec::register(&mut engine);
     critter::register(&mut engine, host);
+    hooks::register(&mut engine, host);
     world::register(&mut engine, host);
     random::register(&mut engine, host);
     kind_decl::register(&mut engine, host);
