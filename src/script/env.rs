@@ -167,7 +167,9 @@ impl<V: Vector> Env<V> for Access<'_, V> {
         caller: CritterId,
         arg: CritterId,
     ) -> Result<Option<f64>, String> {
-        Ok(self.collide_default_pair(caller, arg).map(|hit| hit.impulse))
+        Ok(self
+            .collide_default_pair(caller, arg)
+            .map(|hit| hit.impulse))
     }
     fn age(&self, id: CritterId) -> Option<f64> {
         Access::age(self, id)

@@ -233,8 +233,14 @@ pub(crate) fn define(
         let wrong = mine.iter().find(|n| !arities.contains(n));
         if wrong.is_some() || mine.len() > 1 {
             let message = match wrong {
-                Some(n) => format!("hook {hook} takes ({}), not {n} parameters", hook_params(hook)),
-                None => format!("hook {hook} is defined twice; define it once, with ({})", hook_params(hook)),
+                Some(n) => format!(
+                    "hook {hook} takes ({}), not {n} parameters",
+                    hook_params(hook)
+                ),
+                None => format!(
+                    "hook {hook} is defined twice; define it once, with ({})",
+                    hook_params(hook)
+                ),
             };
             let mut e = ScriptError::new(&file, message);
             if let Some((l, c)) = fn_location(&text, hook) {
@@ -385,8 +391,8 @@ pub(crate) struct HookFrame {
     pub contact: Option<ScriptContact>,
     /// True on the first step of the pair's touching spell (`collide` only).
     pub first: bool,
-    /// The impulse of the last `me.collide_default(other)` in this call.
-    pub impulse: Rc<Cell<f64>>,
+    /// The impulse of the last `me.collide_default(other)` in this call (`collide` only).
+    pub impulse: Option<Rc<Cell<f64>>>,
 }
 
 /// Takes a frame off the host's stack when dropped, also when the call unwinds.
@@ -451,7 +457,7 @@ impl ScriptKind {
             other,
             contact: None,
             first: false,
-            impulse: Rc::new(Cell::new(0.0)),
+            impulse: None,
         }
     }
 
@@ -521,7 +527,9 @@ impl ScriptKind {
         let mut frame = self.frame("collide", f, me, Some(other));
         frame.first = first;
         let got = if f.params == 3 {
-            let contact = contact.with_impulse(frame.impulse.clone());
+            let cell = Rc::new(Cell::new(0.0));
+            frame.impulse = Some(cell.clone());
+            let contact = contact.with_impulse(cell);
             frame.contact = Some(contact.clone());
             self.call(
                 "collide",
@@ -551,9 +559,10 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
         let (me, other) = (ctx.me.id(), ctx.other.id());
         let frame = self.frame("collides_with", f, me, Some(other));
         let args = (CritterRef(me), CritterRef(other));
-        let got = self.rt.host.enter::<V, _>(&mut view, || {
-            self.call("collides_with", f, frame, args)
-        })?;
+        let got = self
+            .rt
+            .host
+            .enter::<V, _>(&mut view, || self.call("collides_with", f, frame, args))?;
         self.rule_of(f, &got)
     }
 
@@ -631,7 +640,11 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
         if let Some(f) = self.def.hook("touch_begin") {
             let (me, other) = (ctx.me().id(), ctx.other().id());
             let frame = self.frame("touch_begin", f, me, Some(other));
-            let args = (CritterRef(me), CritterRef(other), ScriptContact::from(contact));
+            let args = (
+                CritterRef(me),
+                CritterRef(other),
+                ScriptContact::from(contact),
+            );
             self.rt
                 .host
                 .enter::<V, _>(&mut **ctx, || self.call("touch_begin", f, frame, args))
@@ -683,7 +696,9 @@ fn parent_hook(
     let frames = host.frames.borrow();
     let call = format!("me.parent_{hook}");
     let Some(top) = frames.last() else {
-        return fail(format!("{call}(...) can only be called inside the kind's {hook} hook"));
+        return fail(format!(
+            "{call}(...) can only be called inside the kind's {hook} hook"
+        ));
     };
     if top.hook != hook || top.me != me {
         return fail(format!(
@@ -725,14 +740,16 @@ pub(crate) fn parent_collide(
     let (kind, f, frame) = parent_hook(host, "collide", me)?;
     let (Some(kind), Some(f)) = (kind, f) else {
         let impulse = with_env!(host, env => env.collide_default(me, other).or_else(fail))?;
-        if let Some(j) = impulse {
-            frame.impulse.set(j);
+        if let (Some(j), Some(cell)) = (impulse, &frame.impulse) {
+            cell.set(j);
         }
         return Ok(impulse.is_some());
     };
     let contact = match contact.or(frame.contact) {
         Some(c) => c,
-        None if f.params == 3 => with_env!(host, env => ScriptContact::between(env, me, other, frame.first))?,
+        None if f.params == 3 => {
+            with_env!(host, env => ScriptContact::between(env, me, other, frame.first))?
+        }
         None => ScriptContact::default(),
     };
     let mut inner = kind.frame("collide", &f, me, Some(other));
@@ -740,9 +757,15 @@ pub(crate) fn parent_collide(
     // The parent's default response counts for the child's contact too.
     inner.impulse = frame.impulse;
     let got = if f.params == 3 {
-        let contact = contact.with_impulse(inner.impulse.clone());
+        let cell = inner.impulse.get_or_insert_with(|| Rc::new(Cell::new(0.0)));
+        let contact = contact.with_impulse(cell.clone());
         inner.contact = Some(contact.clone());
-        kind.call("collide", &f, inner, (CritterRef(me), CritterRef(other), contact))
+        kind.call(
+            "collide",
+            &f,
+            inner,
+            (CritterRef(me), CritterRef(other), contact),
+        )
     } else {
         kind.call("collide", &f, inner, (CritterRef(me), CritterRef(other)))
     };
@@ -754,8 +777,8 @@ pub(crate) fn parent_collide(
 pub(crate) fn note_default(host: &Host, me: CritterId, other: CritterId, impulse: Option<f64>) {
     if let (Some(j), Ok(frames)) = (impulse, host.frames.try_borrow()) {
         if let Some(top) = frames.last() {
-            if top.hook == "collide" && top.me == me && top.other == Some(other) {
-                top.impulse.set(j);
+            if let (true, Some(cell)) = (top.me == me && top.other == Some(other), &top.impulse) {
+                cell.set(j);
             }
         }
     }
@@ -772,7 +795,12 @@ pub(crate) fn parent_collides_with(host: &Host, me: CritterId, other: CritterId)
     };
     let inner = kind.frame("collides_with", &f, me, frame.other);
     let got = kind
-        .call("collides_with", &f, inner, (CritterRef(me), CritterRef(other)))
+        .call(
+            "collides_with",
+            &f,
+            inner,
+            (CritterRef(me), CritterRef(other)),
+        )
         .map_err(|e| host.carry(e))?;
     kind.rule_of(&f, &got)
         .map(rule_code)
@@ -780,7 +808,12 @@ pub(crate) fn parent_collides_with(host: &Host, me: CritterId, other: CritterId)
 }
 
 /// `me.parent_update(dt)` and `me.parent_init()`: the parent's hook, or nothing.
-pub(crate) fn parent_plain(host: &Host, hook: &'static str, me: CritterId, dt: Option<f64>) -> Res<()> {
+pub(crate) fn parent_plain(
+    host: &Host,
+    hook: &'static str,
+    me: CritterId,
+    dt: Option<f64>,
+) -> Res<()> {
     let (kind, f, _) = parent_hook(host, hook, me)?;
     let (Some(kind), Some(f)) = (kind, f) else {
         return Ok(());

@@ -15,8 +15,8 @@
 //! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
-mod build;
 pub(crate) mod births;
+mod build;
 mod config;
 mod diagnostics;
 mod layout;
@@ -26,9 +26,9 @@ pub(crate) mod state;
 mod state_hash;
 pub(crate) mod stats;
 mod step;
-pub(crate) mod touch;
 #[cfg(test)]
 mod tests;
+pub(crate) mod touch;
 
 pub use config::WorldConfig;
 pub use diagnostics::Diagnostics;
@@ -267,7 +267,11 @@ impl<V: Vector> World<V> {
     /// times dt (0 in its `init`).
     pub fn age(&self, id: CritterId) -> Option<f64> {
         self.state.critters.get(id)?;
-        Some(self.state.births.age(id, self.state.step_count, self.state.dt))
+        Some(
+            self.state
+                .births
+                .age(id, self.state.step_count, self.state.dt),
+        )
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {

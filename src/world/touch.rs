@@ -194,7 +194,9 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
                 ended.push(pair);
             }
         } else {
-            let Some((pair, contact)) = new.next() else { break };
+            let Some((pair, contact)) = new.next() else {
+                break;
+            };
             if alive(state, pair.0) && alive(state, pair.1) {
                 kept.push(pair);
                 if let Some(contact) = contact {
