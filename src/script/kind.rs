@@ -233,10 +233,15 @@ pub(crate) fn define(
         let wrong = mine.iter().find(|n| !arities.contains(n));
         if wrong.is_some() || mine.len() > 1 {
             let message = match wrong {
-                Some(n) => format!(
-                    "hook {hook} takes ({}), not {n} parameters",
-                    hook_params(hook)
-                ),
+                Some(n) => {
+                    let counts: Vec<String> = arities.iter().map(|a| a.to_string()).collect();
+                    let plural = if arities == &[1] { "" } else { "s" };
+                    format!(
+                        "hook {hook} takes {} parameter{plural} ({}), not {n}",
+                        counts.join(" or "),
+                        hook_params(hook)
+                    )
+                }
                 None => format!(
                     "hook {hook} is defined twice; define it once, with ({})",
                     hook_params(hook)
