@@ -1,7 +1,9 @@
 //! The cost of script kinds on the standard gas (10,000 disks, packing fraction 0.4): native
 //! balls against balls whose `collide` is a script calling `collide_default`, and against balls
 //! with an `update` hook, in one run; `+profiled` cases time every hook call as `run --stats`
-//! does. `docs/scripting.md` reports the figures.
+//! does; a `collide` that reads its contact against one that does not (`contact_collide`); and
+//! prey fleeing hunters through `nearby` (`hunt_alternated`). `docs/scripting.md` reports the
+//! figures.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use critterbox::glam::DVec2;
@@ -117,6 +119,53 @@ fn hunt_alternated(_: &mut Criterion) {
     );
 }
 
+/// A three-parameter `collide` that reads its contact (`contact_ball`), and one that takes it
+/// but reads nothing (`contact_unread`), against the same scene's two-parameter `collide`
+/// (`scripted_ball`): rounds of steps of each, alternated; the median ms per step of each and
+/// the medians of the per-round ratios are printed.
+fn contact_collide(_c: &mut Criterion) {
+    const ROUNDS: usize = 9;
+    const STEPS: u32 = 10;
+    let kinds = ["scripted_ball", "contact_unread", "contact_ball"];
+    let mut worlds: Vec<World<DVec2>> = kinds.iter().map(|k| world(k, false)).collect();
+    let time = |w: &mut World<DVec2>| {
+        let start = std::time::Instant::now();
+        for _ in 0..STEPS {
+            w.step().expect("gas steps");
+        }
+        start.elapsed().as_secs_f64() * 1e3 / f64::from(STEPS)
+    };
+    // One round of each first, so all start warm.
+    for w in &mut worlds {
+        time(w);
+    }
+    let mut ms = vec![Vec::new(); kinds.len()];
+    let mut ratios = vec![Vec::new(); kinds.len()];
+    for _ in 0..ROUNDS {
+        let round: Vec<f64> = worlds.iter_mut().map(&time).collect();
+        for (k, t) in round.iter().enumerate() {
+            ms[k].push(*t);
+            ratios[k].push(t / round[0]);
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    eprintln!(
+        "{:.1} collide calls per step; medians of {ROUNDS} alternated rounds of {STEPS} steps:",
+        worlds[0].totals().contacts as f64 / worlds[0].step_count().max(1) as f64
+    );
+    for (k, kind) in kinds.iter().enumerate() {
+        eprintln!(
+            "  {kind}: {:.3} ms/step, {:.3} x scripted_ball",
+            median(&mut ms[k]),
+            median(&mut ratios[k])
+        );
+    }
+}
+
 criterion_group!(benches, script_kinds);
+criterion_group!(contacts, contact_collide);
 criterion_group!(hunt_benches, hunt_alternated);
-criterion_main!(benches, hunt_benches);
+criterion_main!(benches, contacts, hunt_benches);

@@ -53,6 +53,52 @@ impl<V> StepEvents<V> {
     }
 }
 
+/// The contact of a pair as a hook sees it (`collide`'s third argument, `touch_begin`'s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HookContact<V> {
+    /// Unit normal from `me` towards `other`.
+    pub normal: V,
+    /// Contact point (world coordinates).
+    pub point: V,
+    /// Overlap, >= 0.
+    pub depth: f64,
+    /// Approach speed along the normal: > 0 while they approach.
+    pub speed: f64,
+    /// True on the first step of this touching spell.
+    pub first: bool,
+}
+
+impl<V: Vector> HookContact<V> {
+    /// The contact of `me` with `other` where they are now; when they do not touch (a hook moved
+    /// one), the normal along the line of centres and depth 0.
+    pub fn between(topo: &Topology<V>, me: &Critter<V>, other: &Critter<V>, first: bool) -> Self {
+        let (normal, point, depth) = match response::contact_between(topo, me, other) {
+            Some(c) => (c.normal, me.pos + c.point, c.depth),
+            None => {
+                let d = topo.delta(me.pos, other.pos);
+                let len = d.length();
+                let n = if len > 0.0 { d / len } else { V::unit_x() };
+                (n, me.pos + d * 0.5, 0.0)
+            }
+        };
+        HookContact {
+            normal,
+            point,
+            depth,
+            speed: (me.vel - other.vel).dot(normal),
+            first,
+        }
+    }
+
+    /// The same contact seen from the other critter.
+    pub fn flipped(&self) -> Self {
+        HookContact {
+            normal: -self.normal,
+            ..*self
+        }
+    }
+}
+
 /// Spawns waiting for the end of the step.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Pending<V: Vector> {
@@ -124,6 +170,7 @@ pub struct Access<'a, V: Vector> {
     pub(crate) pending: &'a mut Pending<V>,
     pub(crate) events: &'a mut StepEvents<V>,
     pub(crate) vars: &'a mut Props,
+    pub(crate) births: &'a crate::world::births::Births,
     pub(crate) rng: &'a mut Rng,
     pub(crate) neighbours: &'a mut Neighbours<V>,
     pub(crate) step: u64,
@@ -206,6 +253,11 @@ impl<V: Vector> Access<'_, V> {
     /// The scripts' shared state, to change.
     pub fn vars_mut(&mut self) -> &mut Props {
         self.vars
+    }
+    /// Seconds since critter `id` was spawned (see [`crate::world::World::age`]).
+    pub fn age(&self, id: CritterId) -> Option<f64> {
+        self.critters.get(id)?;
+        Some(self.births.age(id, self.step, self.dt))
     }
     /// True when critter `id` is of kind `kind` or a kind that extends it.
     pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {
@@ -316,6 +368,8 @@ pub struct CollideCtx<'a, V: Vector> {
     pub(crate) access: Access<'a, V>,
     pub(crate) me: u32,
     pub(crate) other: u32,
+    /// The call is the first of this pair's touching spell (false while spells are not kept).
+    pub(crate) first: bool,
 }
 
 impl<'a, V: Vector> Deref for CollideCtx<'a, V> {
@@ -366,6 +420,10 @@ impl<V: Vector> CollideCtx<'_, V> {
     /// Distance between the centres (through the border when it wraps).
     pub fn distance(&self) -> f64 {
         self.topo.delta(self.me().pos, self.other().pos).length()
+    }
+    /// The contact of me with the other, where they are now.
+    pub fn contact(&self) -> HookContact<V> {
+        HookContact::between(self.topo, self.me(), self.other(), self.first)
     }
     /// True when the two touch now.
     pub fn touches(&self) -> bool {

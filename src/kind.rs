@@ -4,7 +4,7 @@
 //! implementation of [`KindHooks`]. The native behaviour is the trait's default methods, so
 //! `impl KindHooks for ()` is the plain ball; scripted kinds implement the same trait.
 
-use crate::context::{CollideCtx, UpdateCtx};
+use crate::context::{CollideCtx, HookContact, UpdateCtx};
 use crate::critter::{Critter, CP_CRITTER, CP_WALL};
 use crate::error::Error;
 use crate::vector::Vector;
@@ -114,6 +114,36 @@ pub trait KindHooks<V: Vector> {
     fn init(&self, _ctx: &mut UpdateCtx<'_, V>) -> Result<(), Error> {
         Ok(())
     }
+
+    /// Whether the kind needs touching spells tracked: it has touch hooks, or its `collide`
+    /// reads the contact (`first` says whether a spell begins). Off, the engine keeps no spells.
+    fn tracks_touch(&self) -> bool {
+        false
+    }
+
+    /// Called when a touching spell of `ctx.me` with `ctx.other` begins (see `world::touch`).
+    fn touch_begin(
+        &self,
+        _ctx: &mut CollideCtx<'_, V>,
+        _contact: &HookContact<V>,
+    ) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// Called when a touching spell of `ctx.me` with `ctx.other` ends.
+    fn touch_end(&self, _ctx: &mut CollideCtx<'_, V>) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// Whether [`KindHooks::on_death`] does anything.
+    fn has_on_death(&self) -> bool {
+        false
+    }
+
+    /// Called once when a critter of the kind dies, before it is removed.
+    fn on_death(&self, _ctx: &mut UpdateCtx<'_, V>) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 /// The native behaviour: plain balls and walls.
@@ -175,6 +205,8 @@ pub struct Kind<V: Vector> {
     pub(crate) has_update: bool,
     pub(crate) has_init: bool,
     pub(crate) has_collide: bool,
+    pub(crate) tracks_touch: bool,
+    pub(crate) has_on_death: bool,
     pub(crate) rule_depends_on_state: bool,
 }
 
@@ -182,6 +214,10 @@ pub struct Kind<V: Vector> {
 pub struct KindSet<V: Vector> {
     kinds: Vec<Kind<V>>,
     by_name: BTreeMap<String, KindId>,
+    /// Some kind tracks touching spells (so the step keeps them).
+    tracks_touch: bool,
+    /// Some kind has an `on_death` hook.
+    has_on_death: bool,
 }
 
 /// The kind id of `wall` in every world.
@@ -199,6 +235,8 @@ impl<V: Vector> KindSet<V> {
         let mut set = KindSet {
             kinds: Vec::new(),
             by_name: BTreeMap::new(),
+            tracks_touch: false,
+            has_on_death: false,
         };
         set.insert("ball", None, KindDefaults::default(), Rc::new(()));
         let wall = KindDefaults {
@@ -219,12 +257,16 @@ impl<V: Vector> KindSet<V> {
     ) -> KindId {
         let id = KindId(self.kinds.len() as u32);
         self.by_name.insert(name.to_string(), id);
+        self.tracks_touch |= hooks.tracks_touch();
+        self.has_on_death |= hooks.has_on_death();
         self.kinds.push(Kind {
             name: name.to_string(),
             parent,
             has_update: hooks.has_update(),
             has_init: hooks.has_init(),
             has_collide: hooks.has_collide(),
+            tracks_touch: hooks.tracks_touch(),
+            has_on_death: hooks.has_on_death(),
             rule_depends_on_state: hooks.rule_depends_on_state(),
             defaults,
             hooks,
@@ -291,6 +333,17 @@ impl<V: Vector> KindSet<V> {
             .iter()
             .enumerate()
             .map(|(i, k)| (KindId(i as u32), k))
+    }
+
+    /// True when some kind tracks touching spells (touch hooks or a `collide` that reads the
+    /// contact); when false the step keeps no spells.
+    pub fn tracks_touch(&self) -> bool {
+        self.tracks_touch
+    }
+
+    /// True when some kind has an `on_death` hook.
+    pub fn has_on_death(&self) -> bool {
+        self.has_on_death
     }
 
     /// Number of kinds.

@@ -58,7 +58,7 @@ pub mod world;
 
 pub use border::{Border, Topology};
 pub use broad_phase::BroadPhaseMode;
-pub use context::{Access, CollideCtx, CollisionEvent, StepEvents, UpdateCtx};
+pub use context::{Access, CollideCtx, CollisionEvent, HookContact, StepEvents, UpdateCtx};
 pub use critter::{
     Critter, CritterId, CritterSpec, PropValue, Props, Shape, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
     CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,

@@ -38,7 +38,7 @@ fn movers(w: &World<DVec2>) -> Vec<CritterId> {
 
 // ----- the shipped scenes --------------------------------------------------------------------
 
-const SHIPPED_SCENES: [&str; 7] = [
+const SHIPPED_SCENES: [&str; 8] = [
     "basket_game",
     "billiards",
     "bullets_vs_player",
@@ -46,6 +46,7 @@ const SHIPPED_SCENES: [&str; 7] = [
     "cradle",
     "gas",
     "pile",
+    "splitters",
 ];
 
 #[test]

@@ -440,6 +440,9 @@ fn hook_or_keep<V: Vector>(
     handled: &mut usize,
 ) -> Result<(), Error> {
     if !own_collide(state, caller) {
+        if state.kinds.tracks_touch() {
+            state.note_touch(caller, arg);
+        }
         plain.push((caller, arg));
         return Ok(());
     }

@@ -54,8 +54,11 @@ pub(crate) trait Env<V: Vector> {
         let (x, y) = (self.critter(a)?, self.critter(b)?);
         Some(self.topology().delta(x.pos, y.pos).length())
     }
-    /// The default response; `Err` outside a step.
-    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String>;
+    /// The default response: the impulse it gave when they touched; `Err` outside a step.
+    fn collide_default(&mut self, caller: CritterId, arg: CritterId)
+        -> Result<Option<f64>, String>;
+    /// Seconds since critter `id` was spawned; `None` where it cannot be told.
+    fn age(&self, id: CritterId) -> Option<f64>;
     /// The world itself, between steps (scene setup and `on_step`).
     fn world(&mut self) -> Option<&mut World<V>>;
     /// The shared state `world().vars`; `None` where it is out of reach (`collides_with`).
@@ -148,8 +151,15 @@ impl<V: Vector> Env<V> for World<V> {
             .map(|c| c.id())
             .collect()
     }
-    fn collide_default(&mut self, _caller: CritterId, _arg: CritterId) -> Result<bool, String> {
+    fn collide_default(
+        &mut self,
+        _caller: CritterId,
+        _arg: CritterId,
+    ) -> Result<Option<f64>, String> {
         Err("collide_default can only be called inside a collide hook".into())
+    }
+    fn age(&self, id: CritterId) -> Option<f64> {
+        World::age(self, id)
     }
     fn world(&mut self) -> Option<&mut World<V>> {
         Some(self)
@@ -226,8 +236,17 @@ impl<V: Vector> Env<V> for Access<'_, V> {
     fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
         Access::critters_of(self, kind)
     }
-    fn collide_default(&mut self, caller: CritterId, arg: CritterId) -> Result<bool, String> {
-        Ok(self.collide_default_pair(caller, arg).is_some())
+    fn collide_default(
+        &mut self,
+        caller: CritterId,
+        arg: CritterId,
+    ) -> Result<Option<f64>, String> {
+        Ok(self
+            .collide_default_pair(caller, arg)
+            .map(|hit| hit.impulse))
+    }
+    fn age(&self, id: CritterId) -> Option<f64> {
+        Access::age(self, id)
     }
     fn world(&mut self) -> Option<&mut World<V>> {
         None

@@ -107,6 +107,8 @@ pub(crate) struct Host {
     /// A located error from deeper down (a kind file a scene loaded, a hook run by a spawn),
     /// kept whole while rhai carries its text up through the calling script.
     pub stashed: RefCell<Option<Box<ScriptError>>>,
+    /// The script hooks running, innermost last (for `parent_*` and `contact.impulse`).
+    pub frames: RefCell<Vec<super::kind::HookFrame>>,
 }
 
 /// Puts a host's previous target back when dropped, also when a script call unwinds.
@@ -140,6 +142,7 @@ impl Host {
             scene_steps: Cell::new(None),
             seed_override: Cell::new(None),
             stashed: RefCell::new(None),
+            frames: RefCell::new(Vec::new()),
         }
     }
 

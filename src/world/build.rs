@@ -101,7 +101,29 @@ impl<V: Vector> World<V> {
     }
 
     /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
+    /// The critter's spells end and its `on_death` runs first, when some kind has those hooks;
+    /// what they queue (spawns, further deaths) takes effect before this returns.
     pub fn remove(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
+        let hooked = self.state.kinds.tracks_touch() || self.state.kinds.has_on_death();
+        let mut was_alive = true;
+        if hooked {
+            was_alive = match self.state.critters.get_mut(id) {
+                Some(c) => std::mem::replace(&mut c.alive, false),
+                None => return Err(Error::NoSuchCritter(id)),
+            };
+            if was_alive {
+                super::stages::lifecycle::before_removal(&mut self.state, &[id])?;
+            }
+        }
+        let mut c = self.remove_now(id)?;
+        c.alive = was_alive;
+        if hooked {
+            super::stages::lifecycle::run(&mut self.state, &mut self.methods)?;
+        }
+        Ok(c)
+    }
+
+    fn remove_now(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
         let state = &mut self.state;
         let slot = state.critters.slot_of(id).ok_or(Error::NoSuchCritter(id))?;
         let c = state.critters.remove(id).ok_or(Error::NoSuchCritter(id))?;
@@ -160,6 +182,7 @@ impl<V: Vector> State<V> {
         let has_init = self.kinds.get(critter.kind()).has_init;
         let id = self.critters.insert(|id| Critter { id, ..critter });
         self.neighbours.moved(id);
+        self.births.note(id, self.step_count);
         if has_init {
             self.run_init(id)?;
         }

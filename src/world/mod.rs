@@ -15,6 +15,7 @@
 //! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
+pub(crate) mod births;
 mod build;
 mod config;
 mod diagnostics;
@@ -28,6 +29,7 @@ pub(crate) mod stats;
 mod step;
 #[cfg(test)]
 mod tests;
+pub(crate) mod touch;
 
 pub(crate) use build::{OnOverlap, Placed};
 pub use config::WorldConfig;
@@ -93,6 +95,8 @@ impl<V: Vector> World<V> {
                 events: StepEvents::default(),
                 vars: Props::new(),
                 neighbours: Default::default(),
+                births: Default::default(),
+                touch: Default::default(),
             },
             pairs: Pairs::new(config.broad_phase),
             methods: MethodState::new(config.method, config.sleep),
@@ -271,6 +275,16 @@ impl<V: Vector> World<V> {
     /// Total momentum of the free critters, summed as [`World::kinetic_energy`].
     pub fn momentum(&self) -> V {
         crate::hash::critters::totals(self.state.critters.in_id_order()).1
+    }
+    /// Seconds of simulated time since critter `id` was spawned: the steps begun since then
+    /// times dt (0 in its `init`).
+    pub fn age(&self, id: CritterId) -> Option<f64> {
+        self.state.critters.get(id)?;
+        Some(
+            self.state
+                .births
+                .age(id, self.state.step_count, self.state.dt),
+        )
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {

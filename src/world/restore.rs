@@ -53,6 +53,7 @@ impl<V: Vector> World<V> {
         state.rng = Rng::from_state(rng);
         state.step_count = step;
         state.pending = Pending::default();
+        state.touch.clear();
         state.events.clear();
         self.pairs = Pairs::new(self.pairs.broad.mode);
         self.methods.forget();

@@ -38,6 +38,10 @@ pub(crate) struct State<V: Vector> {
     pub(crate) vars: Props,
     /// The grid neighbour queries use, built on the first one (see `neighbours`).
     pub(crate) neighbours: Neighbours<V>,
+    /// The step each critter was spawned at (for `age`).
+    pub(crate) births: super::births::Births,
+    /// The touching spells, kept when some kind tracks them.
+    pub(crate) touch: super::touch::Spells<V>,
 }
 
 impl<V: Vector> State<V> {
@@ -50,6 +54,7 @@ impl<V: Vector> State<V> {
             pending: &mut self.pending,
             events: &mut self.events,
             vars: &mut self.vars,
+            births: &self.births,
             rng: &mut self.rng,
             neighbours: &mut self.neighbours,
             step: self.step_count,
@@ -74,6 +79,28 @@ impl<V: Vector> State<V> {
         };
         hooks
             .init(&mut ctx)
+            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+    }
+
+    /// Runs critter `id`'s `on_death` hook, if its kind has one.
+    pub(crate) fn run_on_death(&mut self, id: CritterId) -> Result<(), Error> {
+        let step = self.step_count;
+        let Some(me) = self.critters.slot_of(id) else {
+            return Ok(());
+        };
+        let Some(kind) = self.critters.slot(me).map(|c| c.kind()) else {
+            return Ok(());
+        };
+        if !self.kinds.get(kind).has_on_death {
+            return Ok(());
+        }
+        let hooks = self.kinds.get(kind).hooks.clone();
+        let mut ctx = UpdateCtx {
+            access: self.access(),
+            me,
+        };
+        hooks
+            .on_death(&mut ctx)
             .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
     }
 
@@ -127,10 +154,12 @@ impl<V: Vector> State<V> {
         let events_before = self.events.collisions.len();
         // The engine moves critters between collide calls: each call starts with no grid.
         self.neighbours.invalidate();
+        let first = self.kinds.tracks_touch() && self.note_touch(caller, arg);
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,
             other: arg,
+            first,
         };
         let handled = hooks
             .collide(&mut ctx)

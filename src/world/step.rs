@@ -2,13 +2,13 @@
 
 use super::stages::{lifecycle, update};
 use super::stats::{timed, StepStats};
-use super::World;
+use super::{touch, World};
 use crate::error::Error;
 use crate::vector::Vector;
 
 impl<V: Vector> World<V> {
     /// Advances the world by one time step: update hooks, the collision method's move, pairs
-    /// and response, then deaths and spawns.
+    /// and response, the touch events (when some kind tracks touch), then deaths and spawns.
     ///
     /// An error from a hook or a bad queued spawn stops the step where it happened; the world is
     /// then part-way through that step.
@@ -31,6 +31,10 @@ impl<V: Vector> World<V> {
         self.methods
             .step(plan, &mut self.state, &mut self.pairs, &mut stats)?;
         self.state.neighbours.invalidate();
+        if self.state.kinds.tracks_touch() {
+            // Timed with the lifecycle: both send what the step's contacts and deaths started.
+            timed(&mut stats.lifecycle, || touch::run(&mut self.state))?;
+        }
         timed(&mut stats.lifecycle, || {
             lifecycle::run(&mut self.state, &mut self.methods)
         })?;

@@ -341,7 +341,10 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         "collide_default",
         move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
             let a = a.0;
-            with_env!(h, env => env.collide_default(a, b.0).or_else(fail))
+            let hit = with_env!(h, env => env.collide_default(a, b.0).or_else(fail))?;
+            // A collide hook's contact reads the impulse of its last default response.
+            crate::script::kind::note_default(&h, a, b.0, hit);
+            Ok(hit.is_some())
         },
     );
 }

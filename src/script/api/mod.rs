@@ -10,6 +10,7 @@
 //! - [`neighbours`]: `me.nearby(r)`, `me.nearest(kind)`, `world().nearby(pos, r)`;
 //! - [`random`]: seeded randomness from the world's generator;
 //! - [`rules`]: the priority and collide-rule constants, `default_collides_with`;
+//! - [`hooks`]: `Contact`, the `parent_*` calls, `me.age`;
 //! - [`kind_decl`]: what a kind file's top level declares (`extends`, `defaults`);
 //! - [`scene`]: building a scene's world: `world(#{ ... })`, walls, spawning patterns, `spawn`.
 //!
@@ -18,6 +19,7 @@
 
 pub(crate) mod checks;
 mod critter;
+mod hooks;
 mod kind_decl;
 mod neighbours;
 mod random;
@@ -31,6 +33,7 @@ mod vec;
 mod world;
 
 pub(crate) use critter::CritterRef;
+pub(crate) use hooks::ScriptContact;
 pub(crate) use rules::{rule_code, rule_of_code};
 pub(crate) use values::{num_or, props_from_map};
 pub(crate) use world::WorldRef;
@@ -92,6 +95,7 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     rules::register(&mut engine, host);
     vec::register(&mut engine);
     critter::register(&mut engine, host);
+    hooks::register(&mut engine, host);
     world::register(&mut engine, host);
     vars::register(&mut engine, host);
     neighbours::register(&mut engine, host);

@@ -1,6 +1,9 @@
-//! The lifecycle stage: the critters that died in the step are removed (and what rested on
-//! them wakes), then the spawns the hooks queued are added.
+//! The lifecycle stage: the critters that died in the step end their touching spells, run their
+//! `on_death` hooks and are removed (and what rested on them wakes), then the spawns the hooks
+//! queued are added. A death asked for by those hooks is handled in the same way, in a further
+//! round, so every dying critter is seen once.
 
+use crate::critter::CritterId;
 use crate::error::Error;
 use crate::method::state::MethodState;
 use crate::vector::Vector;
@@ -13,17 +16,13 @@ pub(crate) fn run<V: Vector>(
     methods: &mut MethodState<V>,
 ) -> Result<(), Error> {
     let mut gone = Vec::new();
-    for id in std::mem::take(&mut state.pending.deaths) {
-        state.events.deaths.push(id);
-        let slot = state.critters.slot_of(id);
-        if let (Some(slot), Some(c)) = (slot, state.critters.remove(id)) {
-            if c.is_wall() {
-                state.walls.retain(|&w| w != id);
-            }
-            if methods.watches_removals() {
-                gone.push((slot as usize, c.pos, c.radius));
-            }
+    loop {
+        let deaths = std::mem::take(&mut state.pending.deaths);
+        if deaths.is_empty() {
+            break;
         }
+        before_removal(state, &deaths)?;
+        remove(state, methods, deaths, &mut gone);
     }
     if !gone.is_empty() {
         methods.removed(&state.topo, &gone, state.critters.slot_slice());
@@ -44,4 +43,43 @@ pub(crate) fn run<V: Vector>(
         }
     }
     Ok(())
+}
+
+/// What the dying do before they go, when some kind asks for it: end their touching spells,
+/// then run their `on_death`, in the order they died.
+pub(crate) fn before_removal<V: Vector>(
+    state: &mut State<V>,
+    dying: &[CritterId],
+) -> Result<(), Error> {
+    if state.kinds.tracks_touch() {
+        state.end_spells_of(dying)?;
+    }
+    if state.kinds.has_on_death() {
+        for &id in dying {
+            state.run_on_death(id)?;
+        }
+    }
+    Ok(())
+}
+
+/// Removes the critters `deaths`; what rested on them is noted in `gone` when the method
+/// watches removals.
+fn remove<V: Vector>(
+    state: &mut State<V>,
+    methods: &MethodState<V>,
+    deaths: Vec<CritterId>,
+    gone: &mut Vec<(usize, V, f64)>,
+) {
+    for id in deaths {
+        state.events.deaths.push(id);
+        let slot = state.critters.slot_of(id);
+        if let (Some(slot), Some(c)) = (slot, state.critters.remove(id)) {
+            if c.is_wall() {
+                state.walls.retain(|&w| w != id);
+            }
+            if methods.watches_removals() {
+                gone.push((slot as usize, c.pos, c.radius));
+            }
+        }
+    }
 }
