@@ -9,8 +9,8 @@ use crate::kind::{KindId, KindSet};
 use crate::response::{self, Hit};
 use crate::rng::Rng;
 use crate::vector::Vector;
-use crate::world::OnOverlap;
 use crate::world::neighbours::{Filter, Neighbours, Scope};
+use crate::world::OnOverlap;
 use std::ops::{Deref, DerefMut};
 
 /// A collision that happened in a step.

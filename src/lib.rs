@@ -48,6 +48,7 @@ pub mod broad_phase;
 pub mod color;
 
 pub mod method;
+pub mod profile;
 pub mod recording;
 pub mod scenes;
 pub mod script;

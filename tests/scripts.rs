@@ -38,13 +38,14 @@ fn movers(w: &World<DVec2>) -> Vec<CritterId> {
 
 // ----- the shipped scenes --------------------------------------------------------------------
 
-const SHIPPED_SCENES: [&str; 8] = [
+const SHIPPED_SCENES: [&str; 9] = [
     "basket_game",
     "billiards",
     "bullets_vs_player",
     "children",
     "cradle",
     "gas",
+    "hunt",
     "pile",
     "splitters",
 ];

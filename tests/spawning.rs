@@ -94,3 +94,36 @@ fn scene_constants_are_global_names_in_helpers() {
     );
     assert_eq!(of_kind(w2(&scene), "ball").len(), 3);
 }
+
+#[test]
+fn a_hook_asking_for_a_name_that_is_no_kind_is_warned_of_once() {
+    let sandbox = Sandbox::new("unknown_kind_warning");
+    sandbox.kind(
+        "asker",
+        "fn update(me, dt) {\n    if me.is_kind(\"pray\") || world().count(\"pray\") > 0 {\n        me.die();\n    }\n}\n",
+    );
+    let mut scene = sandbox.load(
+        "let w = world(#{ dim: 2, size: vec(10, 10), seed: 1 });\nspawn(\"asker\", #{ pos: vec(5, 5) });\n",
+    );
+    let mut warnings = Vec::new();
+    for _ in 0..4 {
+        scene
+            .step()
+            .expect("an unknown kind in a query does not stop the run");
+        warnings.extend(
+            w2(&scene)
+                .events()
+                .log
+                .iter()
+                .filter(|l| l.contains("no kind 'pray'"))
+                .cloned(),
+        );
+    }
+    assert_eq!(warnings.len(), 1, "warned once over 4 steps: {warnings:?}");
+    assert!(warnings[0].starts_with("warning:"), "{}", warnings[0]);
+    assert_eq!(
+        of_kind(w2(&scene), "asker").len(),
+        1,
+        "the answers were false and none"
+    );
+}

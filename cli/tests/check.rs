@@ -124,7 +124,8 @@ fn check_warns_on_hooks_with_the_wrong_number_of_parameters() {
         "{err}"
     );
     assert!(
-        err.contains(&format!("{file}:2:4: hook touch_begin takes 3")),
+        // Loading the kind fails on it too, so it may come as the load's error (column 1).
+        err.contains(&format!("{file}:2:")) && err.contains("hook touch_begin takes 3"),
         "{err}"
     );
     assert!(!err.contains(":3:4: hook"), "touch_end takes 2: {err}");

@@ -5,8 +5,8 @@
 
 use super::keyframes::default_record_every;
 use super::schema::{FORMAT, STATE_HASH};
+use crate::profile::ProfileRow;
 use crate::scenes::Scene;
-use crate::script::profile::ProfileRow;
 use crate::script::Limits;
 use serde_json::json;
 use std::collections::BTreeMap;

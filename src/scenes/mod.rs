@@ -172,7 +172,7 @@ pub struct Scene {
     /// (set for script scenes).
     pub(crate) loaded_since: Option<Box<dyn Fn(usize) -> Vec<SourceFile>>>,
     /// The script profiler of a script scene's hooks (`run --stats`), off until turned on.
-    pub profiler: Option<std::rc::Rc<crate::script::profile::Profiler>>,
+    pub profiler: Option<std::rc::Rc<crate::profile::Profiler>>,
 }
 
 impl Scene {
@@ -200,7 +200,7 @@ impl Scene {
 
     /// The script profile so far: calls and time per kind and hook (empty unless
     /// `profiler` was turned on).
-    pub fn profile(&self) -> Vec<crate::script::profile::ProfileRow> {
+    pub fn profile(&self) -> Vec<crate::profile::ProfileRow> {
         self.profiler.as_ref().map(|p| p.rows()).unwrap_or_default()
     }
 

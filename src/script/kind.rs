@@ -425,7 +425,7 @@ impl ScriptKind {
         self.rt.host.frames.borrow_mut().push(frame);
         let _pop = Popped(&self.rt.host);
         let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
-        // Timed per kind and hook when the profiler is on (`run --stats`, script/profile.rs).
+        // Timed per kind and hook when the profiler is on (`run --stats`, profile.rs).
         let profiler = &self.rt.profiler;
         let result = profiler.time(&self.def.name, hook, || match f.scope.try_borrow_mut() {
             Ok(mut scope) => self.rt.engine.call_fn_with_options::<Dynamic>(

@@ -14,15 +14,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// The hooks a kind may define, with the numbers of parameters each may take.
-pub const KIND_HOOKS: &[(&str, &[usize])] = &[
-    ("init", &[1]),
-    ("update", &[2]),
-    ("collides_with", &[2]),
-    ("collide", &[2, 3]),
-    ("touch_begin", &[3]),
-    ("touch_end", &[2]),
-    ("on_death", &[1]),
-];
+const KIND_HOOKS: &[(&str, &[usize])] = &kind::HOOKS;
 
 /// The hook a scene may define.
 const SCENE_HOOKS: &[(&str, &[usize])] = &[("on_step", &[1])];
@@ -161,7 +153,12 @@ fn hook_warnings(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Prob
                     file,
                     f.line,
                     f.column,
-                    format!("hook {} takes {want} parameters, not {}", f.name, f.params),
+                    format!(
+                        "hook {} takes {want} parameter{}, not {}",
+                        f.name,
+                        if arities == &[1] { "" } else { "s" },
+                        f.params
+                    ),
                     "see the hooks in docs/scripting.md".into(),
                 ));
             }

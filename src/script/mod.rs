@@ -16,7 +16,7 @@ pub(crate) mod host;
 pub(crate) mod kind;
 pub(crate) mod kind_refs;
 pub mod lint;
-pub mod profile;
+
 pub(crate) mod scene;
 
 pub use lint::{check_file, check_files, FileCheck, Problem, Severity};
@@ -89,8 +89,10 @@ pub(crate) struct Runtime {
     /// Whether a kind name has a file on the kind search path, once asked (see
     /// [`Runtime::kind_exists`]).
     kind_files: RefCell<BTreeMap<String, bool>>,
+    /// Names of no kind that a hook asked for, warned of once each.
+    unknown_warned: RefCell<std::collections::BTreeSet<String>>,
     /// Calls and time per kind and hook, when turned on.
-    pub profiler: Rc<profile::Profiler>,
+    pub profiler: Rc<crate::profile::Profiler>,
 }
 
 /// What a layer above scripts adds to a runtime (the script test runner's API): functions on
@@ -128,7 +130,7 @@ impl Runtime {
                 runtime.clone(),
             ));
             host.seed_override.set(options.seed);
-            let profiler = Rc::new(profile::Profiler::default());
+            let profiler = Rc::new(crate::profile::Profiler::default());
             profiler.set_on(options.profile);
             Runtime {
                 engine: api::build_engine(&host, &options.limits),
@@ -138,6 +140,7 @@ impl Runtime {
                 sources: RefCell::new(Vec::new()),
                 limits: options.limits.clone(),
                 kind_files: RefCell::new(BTreeMap::new()),
+                unknown_warned: RefCell::new(Default::default()),
                 profiler,
             }
         })
@@ -163,6 +166,11 @@ impl Runtime {
         let found = self.resolve_kind(name).is_some();
         self.kind_files.borrow_mut().insert(name.to_string(), found);
         found
+    }
+
+    /// True the first time `name` is passed: a hook asked for a kind that does not exist.
+    pub fn warn_unknown_kind(&self, name: &str) -> bool {
+        self.unknown_warned.borrow_mut().insert(name.to_string())
     }
 
     /// The names of every kind on the kind search path, and the native ones.

@@ -205,7 +205,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         let profile = scene.profile();
         if !profile.is_empty() {
             writeln!(out, "scripts      calls and time per kind and hook")?;
-            write!(out, "{}", critterbox::script::profile::table(&profile))?;
+            write!(out, "{}", critterbox::profile::table(&profile))?;
         }
     }
     let (outcome, reason) = match (&stopped, interrupted) {
@@ -261,7 +261,7 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
     )?)
 }
 
-/// Whether the run times its hooks (script/profile.rs): with `--stats`, whose table it feeds,
+/// Whether the run times its hooks (critterbox::profile): with `--stats`, whose table it feeds,
 /// and the recording's end metadata then keeps the table too.
 fn profiled(args: &RunArgs) -> bool {
     args.stats

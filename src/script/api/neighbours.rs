@@ -4,6 +4,7 @@
 //! of the moment, in id order, looking only at the cells near the asker.
 
 use super::critter::{gone, CritterRef};
+use super::spawn::kind_for_query;
 use super::values::from_svec;
 use super::world::WorldRef;
 use super::{fail, Res};
@@ -31,22 +32,7 @@ enum Ask {
     Nearest,
 }
 
-fn kind_id<V: Vector>(env: &dyn Env<V>, kind: Option<&str>, call: &str) -> Res<Option<KindId>> {
-    let Some(name) = kind else {
-        return Ok(None);
-    };
-    match env.kinds().id(name) {
-        Ok(k) => Ok(Some(k)),
-        Err(e) => fail(format!("{call}: {e}")),
-    }
-}
-
-fn query<V: Vector>(
-    env: &mut dyn Env<V>,
-    from: From,
-    kind: Option<&str>,
-    ask: Ask,
-) -> Res<Dynamic> {
+fn query<V: Vector>(env: &mut dyn Env<V>, from: From, kind: Kind, ask: Ask) -> Res<Dynamic> {
     let call = match ask {
         Ask::Nearby(_) => "nearby",
         Ask::Nearest => "nearest",
@@ -59,7 +45,19 @@ fn query<V: Vector>(
         From::At(p) if p.is_finite() => (from_svec::<V>(p), None),
         From::At(p) => return fail(format!("{call}: position {p} must be finite")),
     };
-    let kind = kind_id(env, kind, call)?;
+    let kind = match kind {
+        Kind::Any => None,
+        Kind::Of(k) => Some(k),
+        // A kind with no critters in this world: nothing to find, once the input is checked.
+        Kind::Absent => {
+            return match ask {
+                Ask::Nearby(r) => check_radius(r)
+                    .or_else(fail)
+                    .map(|()| Dynamic::from_array(Array::new())),
+                Ask::Nearest => Ok(Dynamic::UNIT),
+            };
+        }
+    };
     let handle = |id: CritterId| Dynamic::from(CritterRef(id));
     match ask {
         Ask::Nearby(r) => {
@@ -76,7 +74,22 @@ fn query<V: Vector>(
     }
 }
 
-fn ask(host: &Host, from: From, kind: Option<&str>, ask: Ask) -> Res<Dynamic> {
+/// The kind a query keeps: any, one in the world, or one that has no critters here.
+#[derive(Clone, Copy)]
+enum Kind {
+    Any,
+    Of(KindId),
+    Absent,
+}
+
+fn ask(host: &Rc<Host>, from: From, kind: Option<&str>, ask: Ask) -> Res<Dynamic> {
+    let kind = match kind {
+        None => Kind::Any,
+        Some(name) => match kind_for_query(host, name)? {
+            Some(k) => Kind::Of(k),
+            None => Kind::Absent,
+        },
+    };
     with_env!(host, env => query(env, from, kind, ask))
 }
 

@@ -166,10 +166,11 @@ pub(crate) fn unknown_kind_in_step(kind: &str, e: crate::Error) -> Box<rhai::Eva
     ))
 }
 
-/// The id of kind `name` for a query (`is_kind`, `count`, `critters_of`). Between steps the
-/// kind loads on first use. Inside a step, a kind that exists but is not loaded has no critters
-/// in the world (`None`); a name that is no kind at all is an error naming the known kinds, as
-/// it is almost always a typo.
+/// The id of kind `name` for a query (`is_kind`, `count`, `critters_of`, `nearby`,
+/// `nearest`). Between steps the kind loads on first use. Inside a step, a kind that is not in
+/// the world has no critters there (`None`); a name that is no kind at all (often a typo,
+/// which `critterbox check` reports when it is a literal) also logs a warning, once per name,
+/// as a kind may name kinds a game defines only sometimes (a bullet's `targets`).
 pub(crate) fn kind_for_query(host: &Rc<Host>, name: &str) -> Res<Option<KindId>> {
     let found = with_env!(host, env => Ok(env.kinds().id(name)))?;
     let e = match found {
@@ -179,11 +180,17 @@ pub(crate) fn kind_for_query(host: &Rc<Host>, name: &str) -> Res<Option<KindId>>
     let rt = host.runtime()?;
     let in_step = with_env!(host, env => Ok(env.world().is_none()))?;
     if in_step {
-        return if rt.kind_exists(name) {
-            Ok(None)
-        } else {
-            Err(unknown_kind_in_step(name, e))
-        };
+        if !rt.kind_exists(name) && rt.warn_unknown_kind(name) {
+            let known = match &e {
+                crate::Error::UnknownKind { known, .. } => known.clone(),
+                _ => String::new(),
+            };
+            let line = format!(
+                "warning: no kind '{name}' exists (known kinds: {known}); asking for it finds none"
+            );
+            with_env!(host, env => { env.log(line); Ok(()) })?;
+        }
+        return Ok(None);
     }
     with_env!(host, env => match env.world() {
         Some(world) => load_into(&rt, world, name).map(Some).map_err(|e| host.carry(e)),

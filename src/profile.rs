@@ -1,4 +1,4 @@
-//! The script profiler: calls and time per kind and hook (`run --stats`, and the recording's end
+//! The hook profiler: calls and time per kind and hook (`run --stats`, and the recording's end
 //! metadata). Off by default; a hook call then pays one flag test. When on, each call is timed
 //! with two clock reads and counted in a small table, keyed by kind and hook name.
 //!
