@@ -70,7 +70,7 @@ pub struct ScriptOptions {
     pub kind_dirs: Vec<PathBuf>,
     /// A seed that overrides the scene's own.
     pub seed: Option<u64>,
-    /// Time every hook call per kind and hook from the start ([`profile`]; `run --stats`).
+    /// Time every hook call per kind and hook from the start ([`crate::profile`]; `run --stats`).
     pub profile: bool,
 }
 
