@@ -18,11 +18,25 @@ fn collides_with(me, other) { if other.alive { COLLIDE_AS_CALLER } else { DONT_C
 fn collide(me, other) { me.hits += 1; me.collide_default(other) }
 "#;
 
+/// A bouncer's child with the hooks that call back in from deeper places: the parent's hooks
+/// from inside its own, touch events and `on_death` from the touch and lifecycle stages (and from
+/// a scene's `die`), a neighbour query, and the shared vars.
+const CHILD: &str = r#"
+extends "bouncer";
+defaults(#{ props: #{ impulse: 0.0 } });
+fn update(me, dt) { me.parent_update(dt); let w = world(); w.vars.near += me.nearby(2.0).len(); }
+fn collide(me, other, contact) { let hit = me.parent_collide(other, contact); me.impulse = contact.impulse; hit }
+fn touch_begin(me, other, contact) { let w = world(); w.vars.begins += 1; }
+fn touch_end(me, other) { let w = world(); w.vars.ends += 1; }
+fn on_death(me) { let w = world(); w.vars.deaths += 1; spawn("ball", #{ pos: me.pos, radius: 0.1 }); }
+"#;
+
 /// A runtime that knows the bouncer, and a scope holding `w`, `a` (a bouncer heading right) and
 /// `b` (a ball just right of it), made by a scene-like top level.
 fn setup() -> (Rc<Runtime>, Scope<'static>) {
     let rt = Runtime::new(&ScriptOptions::default(), None);
     define(&rt, "bouncer.rhai".into(), "bouncer".into(), BOUNCER.into()).expect("the kind loads");
+    define(&rt, "child.rhai".into(), "child".into(), CHILD.into()).expect("the child loads");
     let mut scope = Scope::new();
     let _ = run(
         &rt,
@@ -98,10 +112,46 @@ fn scripts_hooks_and_with_scene_take_turns_at_the_scene() {
         4
     );
 
+    // The child's hooks reach the world through nested lending (a parent's hook inside its own,
+    // a spawn inside `on_death`) and from the touch and lifecycle stages.
+    let _ = run(
+        &rt,
+        &mut scope,
+        r#"
+        w.vars.near = 0; w.vars.begins = 0; w.vars.ends = 0; w.vars.deaths = 0;
+        let c = spawn("child", #{ pos: vec(3.0, 1.0), vel: vec(0.0, 3.0) });
+        let d = spawn("ball", #{ pos: vec(3.0, 1.55), radius: 0.25 });
+        "#,
+    );
+    for _ in 0..4 {
+        step(&rt);
+    }
+    let mut got = |e: &str| run(&rt, &mut scope, e);
+    assert!(
+        got("c.impulse").as_float().unwrap() > 0.0,
+        "the parent's collide bounced them"
+    );
+    assert!(
+        got("c.updates").as_int().unwrap() >= 4,
+        "parent_update ran each step"
+    );
+    let _ = got("c.die()");
+    assert!(
+        got("w.vars.near").as_int().unwrap() >= 1,
+        "nearby saw the ball"
+    );
+    assert_eq!(got("w.vars.begins").as_int().unwrap(), 1, "one spell began");
+    assert_eq!(
+        got("w.vars.deaths").as_int().unwrap(),
+        1,
+        "on_death ran once"
+    );
+    assert_eq!(got("w.count(\"child\")").as_int().unwrap(), 0);
+
     // Taken back (as every run does: its kinds hold the runtime, which holds the host), the
     // scene is out of the scripts' reach.
     let scene = rt.host.take_scene().expect("the scene is handed back");
-    assert_eq!(scene.world.step_count(), 3);
+    assert_eq!(scene.world.step_count(), 7);
     let err = rt.engine.eval_with_scope::<INT>(&mut scope, "w.step_count");
     assert!(err.unwrap_err().to_string().contains("no world yet"));
 }
