@@ -234,20 +234,9 @@ pub fn check_file(path: &Path, options: &ScriptOptions) -> FileCheck {
     let rt = Runtime::new(options, path.parent());
     let ty = file_type(&text);
     let loaded = match ty {
-        FileType::Scene => super::load_scene(path, &[], options).map(|scene| {
-            format!(
-                "{file}: scene ok ({}D, {} critters, kinds: {})",
-                scene.world.dim(),
-                scene.world.len(),
-                scene
-                    .world
-                    .count_by_kind()
-                    .keys()
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        }),
+        FileType::Scene => {
+            super::load_scene(path, &[], options).map(|scene| super::scene_ok(&file, &scene))
+        }
         FileType::Kind => kind::load_def(&rt, &file).map(|def| {
             let hooks: Vec<&str> = def.hook_names().collect();
             format!(

@@ -262,19 +262,7 @@ pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, 
         let text = read_script(path)?;
         if scene::looks_like_scene(&text) {
             let scene = load_scene(path, &[], options)?;
-            report.push(format!(
-                "{}: scene ok ({}D, {} critters, kinds: {})",
-                path.display(),
-                scene.world.dim(),
-                scene.world.len(),
-                scene
-                    .world
-                    .count_by_kind()
-                    .keys()
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
+            report.push(scene_ok(&path.display().to_string(), &scene));
         } else {
             let dir = path.parent().map(Path::to_path_buf);
             let rt = Runtime::new(options, dir.as_deref());
@@ -293,4 +281,15 @@ pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, 
         }
     }
     Ok(report)
+}
+
+/// `check`'s line for a scene that loads: its file, dimension, critters and kinds.
+pub(crate) fn scene_ok(file: &str, scene: &Scene) -> String {
+    let kinds: Vec<String> = scene.world.count_by_kind().keys().cloned().collect();
+    format!(
+        "{file}: scene ok ({}D, {} critters, kinds: {})",
+        scene.world.dim(),
+        scene.world.len(),
+        kinds.join(", ")
+    )
 }
