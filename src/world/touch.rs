@@ -91,7 +91,22 @@ impl<V: Vector> State<V> {
 
     /// Calls `touch_end` on both critters of `pair` (lower id first).
     fn send_end(&mut self, pair: Pair) -> Result<(), Error> {
-        for (me, other) in [(pair.0, pair.1), (pair.1, pair.0)] {
+        self.send(pair, None)
+    }
+
+    /// Calls `touch_begin` on both critters of `pair` (lower id first), `contact` seen from the
+    /// lower id.
+    fn send_begin(&mut self, pair: Pair, contact: HookContact<V>) -> Result<(), Error> {
+        self.send(pair, Some(contact))
+    }
+
+    /// `touch_begin` (with the contact seen from the lower id) or `touch_end` (without), on both
+    /// critters of `pair`, lower id first, each from its own side.
+    fn send(&mut self, pair: Pair, contact: Option<HookContact<V>>) -> Result<(), Error> {
+        for (me, other, seen) in [
+            (pair.0, pair.1, contact),
+            (pair.1, pair.0, contact.map(|c| c.flipped())),
+        ] {
             let Some((ms, os, kind_id)) = self.hook_pair(me, other) else {
                 continue;
             };
@@ -101,11 +116,13 @@ impl<V: Vector> State<V> {
                 access: self.access(),
                 me: ms,
                 other: os,
-                first: false,
+                first: seen.is_some(),
             };
-            hooks
-                .touch_end(&mut ctx)
-                .map_err(|e| hook_error(e, &self.kinds, kind_id, me, step))?;
+            match &seen {
+                Some(seen) => hooks.touch_begin(&mut ctx, seen),
+                None => hooks.touch_end(&mut ctx),
+            }
+            .map_err(|e| hook_error(e, &self.kinds, kind_id, me, step))?;
         }
         Ok(())
     }
@@ -120,31 +137,6 @@ impl<V: Vector> State<V> {
         let (ms, os) = (self.critters.slot_of(me)?, self.critters.slot_of(other)?);
         let kind = self.critters.slot(ms)?.kind();
         self.kinds.get(kind).tracks_touch.then_some((ms, os, kind))
-    }
-
-    /// Calls `touch_begin` on both critters of `pair` (lower id first), `contact` seen from the
-    /// lower id.
-    fn send_begin(&mut self, pair: Pair, contact: HookContact<V>) -> Result<(), Error> {
-        for (me, other, seen) in [
-            (pair.0, pair.1, contact),
-            (pair.1, pair.0, contact.flipped()),
-        ] {
-            let Some((ms, os, kind_id)) = self.hook_pair(me, other) else {
-                continue;
-            };
-            let hooks = self.kinds.get(kind_id).hooks.clone();
-            let step = self.step_count;
-            let mut ctx = CollideCtx {
-                access: self.access(),
-                me: ms,
-                other: os,
-                first: true,
-            };
-            hooks
-                .touch_begin(&mut ctx, &seen)
-                .map_err(|e| hook_error(e, &self.kinds, kind_id, me, step))?;
-        }
-        Ok(())
     }
 
     /// Ends every spell of the critters `dying` (touch_end on both sides), in pair order.
