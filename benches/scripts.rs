@@ -87,6 +87,9 @@ fn hunt(prey_kind: &str) -> critterbox::scenes::Scene {
 /// machine falls on all alike; the medians and ratios are printed (`docs/scripting.md`).
 fn hunt_alternated(_: &mut Criterion) {
     use std::time::Instant;
+    if !wanted("hunt_alternated") {
+        return;
+    }
     let kinds = ["prey_idle", "prey", "prey_scan"];
     let mut scenes: Vec<_> = kinds.iter().map(|k| hunt(k)).collect();
     let rounds = 40;
@@ -124,6 +127,9 @@ fn hunt_alternated(_: &mut Criterion) {
 /// (`scripted_ball`): rounds of steps of each, alternated; the median ms per step of each and
 /// the medians of the per-round ratios are printed.
 fn contact_collide(_c: &mut Criterion) {
+    if !wanted("contact_collide") {
+        return;
+    }
     const ROUNDS: usize = 9;
     const STEPS: u32 = 10;
     let kinds = ["scripted_ball", "contact_unread", "contact_ball"];
@@ -163,6 +169,13 @@ fn contact_collide(_c: &mut Criterion) {
             median(&mut ratios[k])
         );
     }
+}
+
+/// True when the bench's filter (its first argument that is not a flag, as criterion takes it)
+/// is absent or part of `name`: `cargo bench --bench scripts -- hunt` runs the hunt alone.
+fn wanted(name: &str) -> bool {
+    let mut args = std::env::args().skip(1).filter(|a| !a.starts_with('-'));
+    args.next().is_none_or(|filter| name.contains(&filter))
 }
 
 criterion_group!(benches, script_kinds);
