@@ -121,6 +121,11 @@ pub trait KindHooks<V: Vector> {
         false
     }
 
+    /// Whether the kind has `touch_begin` or `touch_end` (the touch stage calls no other).
+    fn has_touch_hooks(&self) -> bool {
+        self.tracks_touch()
+    }
+
     /// Called when a touching spell of `ctx.me` with `ctx.other` begins (see `world::touch`).
     fn touch_begin(
         &self,
@@ -205,7 +210,7 @@ pub struct Kind<V: Vector> {
     pub(crate) has_update: bool,
     pub(crate) has_init: bool,
     pub(crate) has_collide: bool,
-    pub(crate) tracks_touch: bool,
+    pub(crate) has_touch_hooks: bool,
     pub(crate) has_on_death: bool,
     pub(crate) rule_depends_on_state: bool,
 }
@@ -265,7 +270,7 @@ impl<V: Vector> KindSet<V> {
             has_update: hooks.has_update(),
             has_init: hooks.has_init(),
             has_collide: hooks.has_collide(),
-            tracks_touch: hooks.tracks_touch(),
+            has_touch_hooks: hooks.has_touch_hooks(),
             has_on_death: hooks.has_on_death(),
             rule_depends_on_state: hooks.rule_depends_on_state(),
             defaults,

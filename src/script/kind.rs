@@ -636,9 +636,12 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
     }
 
     fn tracks_touch(&self) -> bool {
-        self.def.hook("touch_begin").is_some()
-            || self.def.hook("touch_end").is_some()
+        KindHooks::<V>::has_touch_hooks(self)
             || self.def.hook("collide").is_some_and(|f| f.params == 3)
+    }
+
+    fn has_touch_hooks(&self) -> bool {
+        self.def.hook("touch_begin").is_some() || self.def.hook("touch_end").is_some()
     }
 
     fn touch_begin(

@@ -9,8 +9,9 @@
 //! The world drops the grid where the engine itself moves critters (each step's start, after
 //! the update stage, before each `collide` call, before the lifecycle, on restore).
 //!
-//! A query looks at the cells its ball overlaps and the critters in them, never at every
-//! critter. Results are in id order and `nearest` breaks ties by the lower id, so the answers do
+//! A query filtered by kind uses a grid of that kind alone (built on the first such query), so
+//! asking for a few hunters among many prey looks at hunters only. A query looks at the cells its
+//! ball overlaps and the critters in them, never at every critter. Results are in id order and `nearest` breaks ties by the lower id, so the answers do
 //! not depend on where critters are stored or how the grid was built.
 
 use crate::border::Topology;
@@ -34,56 +35,6 @@ struct Item<V> {
     kind: KindId,
     /// The critter was re-filed under a newer item (it moved, or its id index was reused).
     stale: bool,
-}
-
-/// The neighbour grid of a world (see the module docs).
-#[derive(Clone, Debug)]
-pub(crate) struct Neighbours<V: Vector> {
-    valid: bool,
-    /// Cells per axis (1 on axes the dimension lacks).
-    cells: [i64; 3],
-    /// Cell side per axis.
-    side: [f64; 3],
-    min: [f64; 3],
-    wraps: bool,
-    /// By cell (x fastest), its first item.
-    head: Vec<u32>,
-    /// By item, the next item of its cell.
-    next: Vec<u32>,
-    items: Vec<Item<V>>,
-    /// By id index, its critter's current item.
-    home: Vec<u32>,
-    /// Critters a hook may have moved since the last query (only while the grid is valid).
-    touched: Vec<CritterId>,
-    /// Items at the last build, and stale items since.
-    built: usize,
-    stale: usize,
-    /// Largest radius of an item at the last build (items filed since are re-filed critters,
-    /// whose radius `max_radius` also covers).
-    max_radius: f64,
-    /// How many times the grid was built (tests check it is once per stage).
-    builds: u64,
-}
-
-impl<V: Vector> Default for Neighbours<V> {
-    fn default() -> Self {
-        Neighbours {
-            valid: false,
-            cells: [1; 3],
-            side: [1.0; 3],
-            min: [0.0; 3],
-            wraps: false,
-            head: Vec::new(),
-            next: Vec::new(),
-            items: Vec::new(),
-            home: Vec::new(),
-            touched: Vec::new(),
-            built: 0,
-            stale: 0,
-            max_radius: 0.0,
-            builds: 0,
-        }
-    }
 }
 
 /// The read-only world a query looks at.
@@ -119,32 +70,137 @@ enum Span {
     Range(i64, i64),
 }
 
+/// The neighbour grids of a world (see the module docs): one of every critter other than a
+/// wall, and one for each kind a query has filtered by, so that asking for a rare kind looks
+/// only at critters of that kind.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Neighbours<V: Vector> {
+    all: Grid<V>,
+    by_kind: Vec<Grid<V>>,
+    /// Critters a hook may have moved since the grids were built: one log, which each valid
+    /// grid reads from its own cursor ([`Grid::seen`]).
+    touched: Vec<CritterId>,
+    /// How many times a grid was built (tests check it is once per grid and stage).
+    builds: u64,
+}
+
+/// A uniform grid of the centres of the critters other than walls of one kind (and the kinds
+/// extending it), or of every kind.
+#[derive(Clone, Debug)]
+struct Grid<V: Vector> {
+    /// The kind filed here (`None`: every kind).
+    kind: Option<KindId>,
+    valid: bool,
+    /// Cells per axis (1 on axes the dimension lacks).
+    cells: [i64; 3],
+    /// Cell side per axis.
+    side: [f64; 3],
+    min: [f64; 3],
+    wraps: bool,
+    /// By cell (x fastest), its first item.
+    head: Vec<u32>,
+    /// By item, the next item of its cell.
+    next: Vec<u32>,
+    items: Vec<Item<V>>,
+    /// By id index, its critter's current item.
+    home: Vec<u32>,
+    /// How much of the log of touched critters this grid has settled.
+    seen: usize,
+    /// Items at the last build, and stale items since.
+    built: usize,
+    stale: usize,
+    /// Largest radius of an item at the last build (items filed since are re-filed critters,
+    /// whose radius `max_radius` also covers).
+    max_radius: f64,
+}
+
+impl<V: Vector> Default for Grid<V> {
+    fn default() -> Self {
+        Grid {
+            kind: None,
+            valid: false,
+            cells: [1; 3],
+            side: [1.0; 3],
+            min: [0.0; 3],
+            wraps: false,
+            head: Vec::new(),
+            next: Vec::new(),
+            items: Vec::new(),
+            home: Vec::new(),
+            seen: 0,
+            built: 0,
+            stale: 0,
+            max_radius: 0.0,
+        }
+    }
+}
+
 impl<V: Vector> Neighbours<V> {
-    /// Drops the grid: the engine moved critters where the grid cannot see.
+    /// Drops the grids: the engine moved critters where the grids cannot see.
     #[inline]
     pub(crate) fn invalidate(&mut self) {
-        self.valid = false;
+        self.all.valid = false;
+        for g in &mut self.by_kind {
+            g.valid = false;
+        }
         self.touched.clear();
     }
 
     /// Notes that critter `id` may have moved (a write through a hook's or the scene's handle).
     #[inline]
     pub(crate) fn moved(&mut self, id: CritterId) {
-        if self.valid {
+        if self.is_tracking() {
             self.touched.push(id);
         }
     }
 
-    /// True while writes are noted (the grid is built).
+    /// True while writes are noted (some grid is built).
     #[inline]
     pub(crate) fn is_tracking(&self) -> bool {
-        self.valid
+        self.all.valid || self.by_kind.iter().any(|g| g.valid)
     }
 
-    /// How many times the grid has been built.
+    /// How many times a grid has been built.
     #[cfg(test)]
     pub(crate) fn builds(&self) -> u64 {
         self.builds
+    }
+
+    /// The grid for `kind`, built and up to date with every move noted.
+    fn grid(&mut self, at: Scope<'_, V>, kind: Option<KindId>) -> &mut Grid<V> {
+        let i = match kind {
+            None => None,
+            Some(k) => Some(match self.by_kind.iter().position(|g| g.kind == Some(k)) {
+                Some(i) => i,
+                None => {
+                    self.by_kind.push(Grid {
+                        kind: Some(k),
+                        ..Grid::default()
+                    });
+                    self.by_kind.len() - 1
+                }
+            }),
+        };
+        let grid = match i {
+            None => &mut self.all,
+            Some(i) => &mut self.by_kind[i],
+        };
+        if grid.ready(at, &self.touched) {
+            self.builds += 1;
+        }
+        // Every grid has read the whole log: start it afresh.
+        let log = self.touched.len();
+        if log > 0 && self.all.read(log) && self.by_kind.iter().all(|g| g.read(log)) {
+            self.touched.clear();
+            self.all.seen = 0;
+            for g in &mut self.by_kind {
+                g.seen = 0;
+            }
+        }
+        match i {
+            None => &mut self.all,
+            Some(i) => &mut self.by_kind[i],
+        }
     }
 
     /// The live critters other than walls within `r` of `centre` (through the border when it
@@ -156,18 +212,16 @@ impl<V: Vector> Neighbours<V> {
         r: f64,
         filter: Filter,
     ) -> Vec<CritterId> {
-        self.ready(at);
+        let grid = self.grid(at, filter.kind);
         let mut out = Vec::new();
         // Above this squared distance no item can be within `r` (the square root is then spared).
         let far = r * r * (1.0 + 4.0 * f64::EPSILON) + f64::MIN_POSITIVE;
-        self.visit(centre, r, |item| {
-            // The kind first: it is the cheapest test and the one most items fail. A live
-            // item's position is its critter's (`settle` re-filed every move).
-            if of_kind(at, item, filter) {
-                let d = at.topo.delta(centre, item.pos);
-                if d.length_squared() <= far && d.length() <= r && passes(at, item, filter) {
-                    out.push(item.id);
-                }
+        grid.visit(centre, r, |item| {
+            // Every item of the grid is of the kind asked for. A live item's position is its
+            // critter's (`settle` re-filed every move).
+            let d = at.topo.delta(centre, item.pos);
+            if d.length_squared() <= far && d.length() <= r && passes(at, item, filter) {
+                out.push(item.id);
             }
             false
         });
@@ -184,18 +238,15 @@ impl<V: Vector> Neighbours<V> {
         centre: V,
         filter: Filter,
     ) -> Option<CritterId> {
-        self.ready(at);
+        let grid = self.grid(at, filter.kind);
         let dim = V::DIM;
-        let mut reach = self.side[..dim]
+        let mut reach = grid.side[..dim]
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min);
         loop {
             let mut best: Option<(f64, CritterId)> = None;
-            self.visit(centre, reach, |item| {
-                if !of_kind(at, item, filter) {
-                    return false;
-                }
+            grid.visit(centre, reach, |item| {
                 let d = at.topo.delta(centre, item.pos).length();
                 let better = best.is_none_or(|(bd, bid)| d < bd || (d == bd && item.id < bid));
                 if better && passes(at, item, filter) {
@@ -206,7 +257,7 @@ impl<V: Vector> Neighbours<V> {
             // Every critter within `reach` was looked at; a nearer one than `best` would be too.
             match best {
                 Some((d, id)) if d <= reach => return Some(id),
-                _ if self.covers_all(centre, reach) => return best.map(|(_, id)| id),
+                _ if grid.covers_all(centre, reach) => return best.map(|(_, id)| id),
                 _ => reach *= 2.0,
             }
         }
@@ -222,35 +273,52 @@ impl<V: Vector> Neighbours<V> {
         reach: f64,
         mut hit: impl FnMut(&Critter<V>) -> bool,
     ) -> bool {
-        self.ready(at);
-        let reach = reach + self.max_radius;
+        let grid = self.grid(at, None);
+        let reach = reach + grid.max_radius;
         let mut found = false;
-        self.visit(centre, reach, |item| {
+        grid.visit(centre, reach, |item| {
             found = at.critters.get(item.id).is_some_and(&mut hit);
             found
         });
         found
     }
+}
 
-    /// Builds the grid if it is not valid, and re-files the critters noted since the last query.
-    fn ready(&mut self, at: Scope<'_, V>) {
+impl<V: Vector> Grid<V> {
+    /// True when the grid is valid and has settled the first `log` entries of the log.
+    fn read(&self, log: usize) -> bool {
+        !self.valid || self.seen == log
+    }
+
+    /// True when a critter of kind `kind` is filed here.
+    fn files(&self, kinds: &KindSet<V>, kind: KindId) -> bool {
+        self.kind.is_none_or(|k| kinds.is_kind(kind, k))
+    }
+
+    /// Builds the grid if it is not valid, and re-files the critters noted in `touched` since
+    /// it last looked; true when it was built.
+    fn ready(&mut self, at: Scope<'_, V>, touched: &[CritterId]) -> bool {
         if self.valid {
-            self.settle(at.critters);
+            self.settle(at, &touched[self.seen..]);
         }
+        self.seen = touched.len();
         // Too many re-filed items (or a grid grown far past what it was sized for): rebuild.
-        if !self.valid
+        let rebuild = !self.valid
             || self.stale * 2 > self.items.len() + 64
-            || self.items.len() > 2 * self.built + 64
-        {
+            || self.items.len() > 2 * self.built + 64;
+        if rebuild {
             self.build(at);
         }
+        rebuild
     }
 
     fn build(&mut self, at: Scope<'_, V>) {
-        self.builds += 1;
-        let (topo, critters) = (at.topo, at.critters);
+        let (topo, critters, kinds) = (at.topo, at.critters, at.kinds);
+        let want = self.kind;
+        let filed =
+            move |c: &&Critter<V>| !c.is_wall() && want.is_none_or(|k| kinds.is_kind(c.kind(), k));
+        let count = critters.iter_stored().filter(filed).count();
         let dim = V::DIM;
-        let count = critters.iter_stored().filter(|c| !c.is_wall()).count();
         let size = topo.size();
         let volume: f64 = (0..dim).map(|a| size.get(a)).product();
         // About two critters a cell.
@@ -281,7 +349,7 @@ impl<V: Vector> Neighbours<V> {
         let mut start = vec![0u32; ncells + 1];
         let mut cell_of = Vec::with_capacity(count);
         let mut max_radius: f64 = 0.0;
-        for c in critters.iter_stored().filter(|c| !c.is_wall()) {
+        for c in critters.iter_stored().filter(filed) {
             let cell = self.cell(c.pos);
             start[cell + 1] += 1;
             cell_of.push(cell);
@@ -302,11 +370,7 @@ impl<V: Vector> Neighbours<V> {
             stale: true,
         };
         self.items.resize(count, blank);
-        for (c, &cell) in critters
-            .iter_stored()
-            .filter(|c| !c.is_wall())
-            .zip(&cell_of)
-        {
+        for (c, &cell) in critters.iter_stored().filter(filed).zip(&cell_of) {
             let i = fill[cell] as usize;
             fill[cell] += 1;
             self.items[i] = Item {
@@ -333,18 +397,17 @@ impl<V: Vector> Neighbours<V> {
         self.built = count;
         self.stale = 0;
         self.max_radius = max_radius;
-        self.touched.clear();
         self.valid = true;
     }
 
-    /// Re-files the noted critters whose centre or radius changed, and files new ones.
-    fn settle(&mut self, critters: &CritterSet<V>) {
-        let touched = std::mem::take(&mut self.touched);
-        for &id in &touched {
-            let Some(c) = critters.get(id) else {
+    /// Re-files the critters in `touched` whose centre or radius changed, and files new ones
+    /// of the grid's kind.
+    fn settle(&mut self, at: Scope<'_, V>, touched: &[CritterId]) {
+        for &id in touched {
+            let Some(c) = at.critters.get(id) else {
                 continue; // gone: its item is skipped by every query
             };
-            if c.is_wall() {
+            if c.is_wall() || !self.files(at.kinds, c.kind()) {
                 continue;
             }
             let index = id.index as usize;
@@ -357,8 +420,10 @@ impl<V: Vector> Neighbours<V> {
                 if item.id == id && item.pos == c.pos && item.radius == c.radius {
                     continue;
                 }
-                item.stale = true;
-                self.stale += 1;
+                if !item.stale {
+                    item.stale = true;
+                    self.stale += 1;
+                }
             }
             let cell = self.cell(c.pos);
             let i = self.items.len() as u32;
@@ -374,8 +439,6 @@ impl<V: Vector> Neighbours<V> {
             self.home[index] = i;
             self.max_radius = self.max_radius.max(c.radius);
         }
-        self.touched = touched;
-        self.touched.clear();
     }
 
     /// The cell coordinate of `x` along `axis` (wrapped, or clamped to the grid).
@@ -472,19 +535,12 @@ impl<V: Vector> Neighbours<V> {
     }
 }
 
-/// True when the critter filed as `item` is of the kind `filter` asks for (or any).
-#[inline]
-fn of_kind<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
-    filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k))
-}
-
-/// True when the critter filed as `item` is still there, alive, not left out, and of the kind
-/// `filter` asks for.
+/// True when the critter filed as `item` is still there, alive and not left out. (Its kind is
+/// the one `filter` asks for: the grid asked holds that kind alone.)
 #[inline]
 fn passes<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
-    filter.exclude != Some(item.id)
-        && of_kind(at, item, filter)
-        && at.critters.get(item.id).is_some_and(|c| c.alive)
+    debug_assert!(filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k)));
+    filter.exclude != Some(item.id) && at.critters.get(item.id).is_some_and(|c| c.alive)
 }
 
 impl<V: Vector> State<V> {

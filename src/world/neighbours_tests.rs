@@ -154,12 +154,14 @@ impl KindHooks<DVec2> for Mover {
             ctx.me_mut().pos = DVec2::new(20.0 - p.y, p.x);
         }
         let centre = ctx.me().pos;
-        for r in [1.0, 4.0] {
-            let got = ctx.nearby(centre, r, None, Some(me));
+        // Every critter, then the mover kind's own grid.
+        for (r, kind) in [(1.0, None), (4.0, None), (4.0, Some(ctx.me().kind()))] {
+            let got = ctx.nearby(centre, r, kind, Some(me));
             let want: Vec<CritterId> = ctx
                 .critters
                 .iter()
                 .filter(|c| c.alive && !c.is_wall() && c.id != me)
+                .filter(|c| kind.is_none_or(|k| c.kind() == k))
                 .filter(|c| ctx.topo.delta(centre, c.pos).length() <= r)
                 .map(|c| c.id)
                 .collect();
@@ -194,11 +196,11 @@ fn queries_inside_an_update_stage_see_the_moves_hooks_made() {
         w.step().unwrap();
         assert_eq!(
             w.state.neighbours.builds() - before,
-            1,
-            "one grid serves the whole update stage"
+            2,
+            "one grid of all and one of the kind serve the whole update stage"
         );
     }
-    assert_eq!(asked.get(), 3 * 300 * 2);
+    assert_eq!(asked.get(), 3 * 300 * 3);
     assert_eq!(wrong.get(), 0, "every answer matched the scan");
 }
 

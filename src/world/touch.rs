@@ -18,7 +18,8 @@ use crate::context::{CollideCtx, HookContact};
 use crate::critter::CritterId;
 use crate::error::Error;
 use crate::vector::Vector;
-use std::collections::BTreeMap;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// A pair, lower id first.
 type Pair = (CritterId, CritterId);
@@ -29,15 +30,38 @@ pub(crate) struct Spells<V> {
     /// Pairs whose spell went on at the end of the last step, ascending.
     open: Vec<Pair>,
     /// Pairs touching in this step so far; for a pair not in `open`, its contact when it first
-    /// touched, seen from the lower id.
-    now: BTreeMap<Pair, Option<HookContact<V>>>,
+    /// touched, seen from the lower id. Hashed, as every `collide` call asks it; the touch
+    /// stage sorts it.
+    now: HashMap<Pair, Option<HookContact<V>>, BuildHasherDefault<PairHasher>>,
+}
+
+/// A multiply-rotate hash of a pair's words: ids are small integers, which need no defence
+/// against chosen collisions, and the std SipHash would cost more than the map's other work.
+#[derive(Default)]
+struct PairHasher(u64);
+
+impl Hasher for PairHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u32(&mut self, word: u32) {
+        self.write_u64(u64::from(word));
+    }
+    fn write_u64(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
 }
 
 impl<V> Default for Spells<V> {
     fn default() -> Self {
         Spells {
             open: Vec::new(),
-            now: BTreeMap::new(),
+            now: HashMap::default(),
         }
     }
 }
@@ -127,8 +151,8 @@ impl<V: Vector> State<V> {
         Ok(())
     }
 
-    /// The slots of `me` and `other` and `me`'s kind, when both are there and the kind tracks
-    /// touch.
+    /// The slots of `me` and `other` and `me`'s kind, when both are there and the kind has
+    /// touch hooks.
     fn hook_pair(
         &self,
         me: CritterId,
@@ -136,7 +160,10 @@ impl<V: Vector> State<V> {
     ) -> Option<(u32, u32, crate::kind::KindId)> {
         let (ms, os) = (self.critters.slot_of(me)?, self.critters.slot_of(other)?);
         let kind = self.critters.slot(ms)?.kind();
-        self.kinds.get(kind).tracks_touch.then_some((ms, os, kind))
+        self.kinds
+            .get(kind)
+            .has_touch_hooks
+            .then_some((ms, os, kind))
     }
 
     /// Ends every spell of the critters `dying` (touch_end on both sides), in pair order.
@@ -152,7 +179,8 @@ impl<V: Vector> State<V> {
 /// The touch stage: compares the pairs that touched in this step with the spells that went on,
 /// and sends the ends, then the begins (see the module docs). Runs only while spells are kept.
 pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
-    let now = std::mem::take(&mut state.touch.now);
+    let mut now: Vec<_> = state.touch.now.drain().collect();
+    now.sort_unstable_by_key(|(pair, _)| *pair);
     let open = std::mem::take(&mut state.touch.open);
     let alive = |state: &State<V>, id: CritterId| state.critters.get(id).is_some_and(|c| c.alive);
     let mut kept = Vec::with_capacity(open.len() + now.len());

@@ -15,7 +15,7 @@ use crate::script::host::{with_env, Host};
 use crate::vector::Vector;
 use crate::world::neighbours::check_radius;
 use glam::DVec3;
-use rhai::{Array, Dynamic, Engine};
+use rhai::{Array, Dynamic, Engine, INT};
 use std::rc::Rc;
 
 /// Where a query is centred: a critter (left out of the answer) or a point.
@@ -93,44 +93,84 @@ fn ask(host: &Rc<Host>, from: From, kind: Option<&str>, ask: Ask) -> Res<Dynamic
     with_env!(host, env => query(env, from, kind, ask))
 }
 
-fn radius(r: &Dynamic) -> Res<f64> {
-    super::num_or(r, "nearby radius")
+/// A radius as scripts write it: a float or an integer.
+trait Radius: Copy + Send + Sync + 'static {
+    fn get(self) -> f64;
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+impl Radius for f64 {
+    fn get(self) -> f64 {
+        self
+    }
+}
+
+impl Radius for INT {
+    fn get(self) -> f64 {
+        self as f64
+    }
+}
+
+/// Registers the four `nearby` forms for radius type `R`: typed parameters let rhai find the
+/// function at its first lookup, where a `Dynamic` one makes it try every pattern of wildcards
+/// on each call.
+fn register_nearby<R: Radius>(engine: &mut Engine, host: &Rc<Host>) {
+    let h = host.clone();
+    engine.register_fn("nearby", move |me: &mut CritterRef, r: R| -> Res<Dynamic> {
+        ask(&h, From::Me(me.0), None, Ask::Nearby(r.get()))
+    });
     let h = host.clone();
     engine.register_fn(
         "nearby",
-        move |me: &mut CritterRef, r: Dynamic| -> Res<Dynamic> {
-            ask(&h, From::Me(me.0), None, Ask::Nearby(radius(&r)?))
+        move |me: &mut CritterRef, r: R, kind: &str| -> Res<Dynamic> {
+            ask(&h, From::Me(me.0), Some(kind), Ask::Nearby(r.get()))
         },
     );
     let h = host.clone();
     engine.register_fn(
         "nearby",
-        move |me: &mut CritterRef, r: Dynamic, kind: &str| -> Res<Dynamic> {
-            ask(&h, From::Me(me.0), Some(kind), Ask::Nearby(radius(&r)?))
+        move |_: &mut WorldRef, pos: DVec3, r: R| -> Res<Dynamic> {
+            ask(&h, From::At(pos), None, Ask::Nearby(r.get()))
         },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "nearby",
+        move |_: &mut WorldRef, pos: DVec3, r: R, kind: &str| -> Res<Dynamic> {
+            ask(&h, From::At(pos), Some(kind), Ask::Nearby(r.get()))
+        },
+    );
+}
+
+/// The error of a `nearby` whose radius is not a number or whose kind is not a string. The
+/// typed forms are found first; these `Dynamic` ones are reached only when they do not fit.
+fn bad_nearby(args: &[&Dynamic]) -> Res<Dynamic> {
+    let types: Vec<&str> = args.iter().map(|a| a.type_name()).collect();
+    fail(format!(
+        "nearby takes a radius (a number >= 0) and may take a kind name (a string), \
+         but got nearby({}): give the radius as a number, e.g. nearby(5.0, \"prey\")",
+        types.join(", ")
+    ))
+}
+
+pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+    register_nearby::<f64>(engine, host);
+    register_nearby::<INT>(engine, host);
+    engine.register_fn("nearby", |_: &mut CritterRef, r: Dynamic| bad_nearby(&[&r]));
+    engine.register_fn("nearby", |_: &mut CritterRef, r: Dynamic, k: Dynamic| {
+        bad_nearby(&[&r, &k])
+    });
+    engine.register_fn("nearby", |_: &mut WorldRef, p: Dynamic, r: Dynamic| {
+        bad_nearby(&[&p, &r])
+    });
+    engine.register_fn(
+        "nearby",
+        |_: &mut WorldRef, p: Dynamic, r: Dynamic, k: Dynamic| bad_nearby(&[&p, &r, &k]),
     );
     let h = host.clone();
     engine.register_fn(
         "nearest",
         move |me: &mut CritterRef, kind: &str| -> Res<Dynamic> {
             ask(&h, From::Me(me.0), Some(kind), Ask::Nearest)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "nearby",
-        move |_: &mut WorldRef, pos: DVec3, r: Dynamic| -> Res<Dynamic> {
-            ask(&h, From::At(pos), None, Ask::Nearby(radius(&r)?))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "nearby",
-        move |_: &mut WorldRef, pos: DVec3, r: Dynamic, kind: &str| -> Res<Dynamic> {
-            ask(&h, From::At(pos), Some(kind), Ask::Nearby(radius(&r)?))
         },
     );
     let h = host.clone();
