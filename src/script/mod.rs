@@ -14,6 +14,7 @@ pub(crate) mod env;
 pub(crate) mod errors;
 pub(crate) mod host;
 pub(crate) mod kind;
+pub(crate) mod kind_calls;
 pub(crate) mod kind_refs;
 pub mod lint;
 
