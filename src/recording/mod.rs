@@ -27,6 +27,7 @@ pub mod reader;
 pub mod rebuild;
 pub mod recover;
 pub mod replay;
+pub mod scan;
 pub mod schema;
 pub mod verify;
 pub mod writer;

@@ -28,8 +28,5 @@ pub fn run(args: &ExportArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out, "{:<40} {rows} rows", path.display())?;
     }
     writeln!(out, "states       {} steps", done.states)?;
-    if let Some(t) = &done.truncated {
-        writeln!(out, "warning      the file is cut off: {t}")?;
-    }
-    Ok(())
+    super::replay::damage_outcome(&rec)
 }
