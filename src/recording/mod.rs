@@ -17,6 +17,7 @@
 
 pub mod capture;
 pub mod compare;
+pub mod diff;
 mod error;
 pub mod export;
 pub mod foxglove;
