@@ -142,7 +142,11 @@ fn a_damaged_chunk_loses_only_its_own_steps_and_every_reader_says_which() {
         assert!(!out.contains("verify       ok"), "{out}");
     }
     let steps = std::fs::read_to_string(dir.join("csv/steps.csv")).expect("steps.csv");
-    assert_eq!(steps.lines().count(), 1 + kept.len(), "one row per kept step");
+    assert_eq!(
+        steps.lines().count(),
+        1 + kept.len(),
+        "one row per kept step"
+    );
     let recovered = Recording::open(&dir.join("recovered.mcap")).expect("recovered");
     assert_eq!(recovered.hashes, r.hashes);
     // The copy lacks the steps too, and says so.
@@ -266,7 +270,10 @@ fn diff_names_the_first_velocity_energy_and_impulse_that_differ() {
             .expect("state");
         critterbox::recording::schema::id_of(s.id[9]).to_string()
     };
-    assert!(out.contains(&format!("critter {id} (ball): vx A ")), "{out}");
+    assert!(
+        out.contains(&format!("critter {id} (ball): vx A ")),
+        "{out}"
+    );
 
     let e = dir.join("energy.mcap");
     edit_message(&a, &e, schema::TOTALS, Some(40), |m| {
@@ -292,7 +299,10 @@ fn diff_names_the_first_velocity_energy_and_impulse_that_differ() {
     let (code, out) = diff(&a, &i);
     assert_eq!(code, Some(1), "{out}");
     assert!(
-        out.contains(&format!("first differs at step {}: collisions impulse[0]", step.get())),
+        out.contains(&format!(
+            "first differs at step {}: collisions impulse[0]",
+            step.get()
+        )),
         "{out}"
     );
     assert!(out.contains(&format!("A {old} | B {new}")), "{out}");
@@ -320,7 +330,10 @@ fn diff_names_a_changed_scene_text_and_log_line() {
     );
     let (code, out) = diff(&a, &b);
     assert_eq!(code, Some(1), "{out}");
-    assert!(out.contains("line 6: A (no line) | B `// a comment`"), "{out}");
+    assert!(
+        out.contains("line 6: A (no line) | B `// a comment`"),
+        "{out}"
+    );
 
     let l = dir.join("log.mcap");
     edit_message(&a, &l, schema::LOG, None, |m| {
@@ -328,5 +341,8 @@ fn diff_names_a_changed_scene_text_and_log_line() {
     });
     let (code, out) = diff(&a, &l);
     assert_eq!(code, Some(1), "{out}");
-    assert!(out.contains("log lines[0]: A \"tick 5\" | B \"tock\""), "{out}");
+    assert!(
+        out.contains("log lines[0]: A \"tick 5\" | B \"tock\""),
+        "{out}"
+    );
 }

@@ -148,7 +148,10 @@ pub fn diff(a: &Recording, b: &Recording) -> Result<DiffReport, RecordingError> 
     let (ra, rb) = (feed(a.path.clone()), feed(b.path.clone()));
     let (mut cut_a, mut cut_b) = (false, false);
     let mut kinds: BTreeMap<u64, String> = BTreeMap::new();
-    let (mut ga, mut gb) = (next(&ra, &a.path, &mut cut_a)?, next(&rb, &b.path, &mut cut_b)?);
+    let (mut ga, mut gb) = (
+        next(&ra, &a.path, &mut cut_a)?,
+        next(&rb, &b.path, &mut cut_b)?,
+    );
     loop {
         match (&ga, &gb) {
             (None, None) => break,
@@ -199,7 +202,9 @@ pub fn diff(a: &Recording, b: &Recording) -> Result<DiffReport, RecordingError> 
 /// True when `rec` has no hash for `step` but has later ones: a hole a damaged chunk left (in
 /// a copy `recover` made).
 fn lacks(rec: &Recording, step: u64) -> bool {
-    rec.missing_ranges().iter().any(|&(a, b)| a <= step && step <= b)
+    rec.missing_ranges()
+        .iter()
+        .any(|&(a, b)| a <= step && step <= b)
 }
 
 fn only_in(g: &StepGroup, name: &str, other: &Recording, ended: bool) -> String {
@@ -325,10 +330,17 @@ fn describe(topic: &str, da: &[u8], db: &[u8], kinds: &BTreeMap<u64, String>) ->
         return format!("the {} messages differ (one does not parse)", short(topic));
     };
     let Some((path, index, x, y)) = first_json_difference(&va, &vb) else {
-        return format!("the {} messages differ in their encoding only", short(topic));
+        return format!(
+            "the {} messages differ in their encoding only",
+            short(topic)
+        );
     };
     match topic {
-        schema::HASH => format!("state hash {} | {}", x.trim_matches('"'), y.trim_matches('"')),
+        schema::HASH => format!(
+            "state hash {} | {}",
+            x.trim_matches('"'),
+            y.trim_matches('"')
+        ),
         schema::COLLISIONS => {
             let c: Option<CollisionsMsg> = serde_json::from_value(va).ok();
             let pair = index.zip(c).and_then(|(i, c)| {
@@ -338,7 +350,10 @@ fn describe(topic: &str, da: &[u8], db: &[u8], kinds: &BTreeMap<u64, String>) ->
                     who(*c.arg.get(i)?)
                 ))
             });
-            format!("collisions {path}{}: A {x} | B {y}", pair.unwrap_or_default())
+            format!(
+                "collisions {path}{}: A {x} | B {y}",
+                pair.unwrap_or_default()
+            )
         }
         _ => format!("{} {path}: A {x} | B {y}", short(topic)),
     }
@@ -409,11 +424,13 @@ pub fn script_differences(a: &[(String, String)], b: &[(String, String)]) -> Vec
                 if na != nb {
                     out.push(format!("script {}: named {na} in A, {nb} in B", i + 1));
                 } else if ta != tb {
-                    let (la, lb): (Vec<&str>, Vec<&str>) = (ta.lines().collect(), tb.lines().collect());
+                    let (la, lb): (Vec<&str>, Vec<&str>) =
+                        (ta.lines().collect(), tb.lines().collect());
                     let line = (0..la.len().max(lb.len()))
                         .find(|&l| la.get(l) != lb.get(l))
                         .unwrap_or(0);
-                    let show = |v: Option<&&str>| v.map_or("(no line)".to_string(), |s| format!("`{s}`"));
+                    let show =
+                        |v: Option<&&str>| v.map_or("(no line)".to_string(), |s| format!("`{s}`"));
                     out.push(format!(
                         "script {na} line {}: A {} | B {}",
                         line + 1,

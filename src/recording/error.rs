@@ -26,9 +26,7 @@ pub enum RecordingError {
         path: PathBuf,
     },
     /// Part of the file could not be read (damaged or cut off); what could be read was used.
-    #[error(
-"{path} is damaged or incomplete: {what}"
-    )]
+    #[error("{path} is damaged or incomplete: {what}")]
     Damaged {
         /// The file.
         path: PathBuf,

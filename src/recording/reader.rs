@@ -5,9 +5,9 @@
 
 use super::error::{with_causes, RecordingError};
 use super::meta::{EndMeta, RunMeta};
-use super::schema::{self, ErrorMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg};
 pub use super::scan::Damage;
 use super::scan::{Event, Scanner};
+use super::schema::{self, ErrorMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg};
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::Read;
@@ -396,7 +396,10 @@ impl Recording {
                 } else {
                     format!("steps {a}..{b} are")
                 };
-                lines.push(format!("{steps} missing from the file{}", self.recovered_note()));
+                lines.push(format!(
+                    "{steps} missing from the file{}",
+                    self.recovered_note()
+                ));
             }
         }
         if let Some(t) = &self.truncated {

@@ -10,6 +10,7 @@
 //! not damaged.
 
 use mcap::records::{op, Record};
+use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
@@ -111,14 +112,19 @@ impl Scanner {
                 self.cut_off(start, "the file ends in the middle of a record");
                 continue;
             };
-            let end = start + RECORD_HEAD + length;
+            let end = start.saturating_add(RECORD_HEAD).saturating_add(length);
             let plausible = opcode_known(opcode) && length <= RECORD_LIMIT;
             if !plausible || end > self.len {
                 // A record longer than the rest of the file is the last one of a cut-off file,
                 // unless good records follow (then its header was damaged).
                 if plausible {
                     if let Some(next) = self.resync(start)? {
-                        return Ok(Some(self.damaged(start, next, "record", "its length is wrong")));
+                        return Ok(Some(self.damaged(
+                            start,
+                            next,
+                            "record",
+                            "its length is wrong",
+                        )));
                     }
                     self.cut_off(start, "the file ends in the middle of a record");
                     continue;
@@ -126,8 +132,9 @@ impl Scanner {
                 let next = self.resync(start)?.unwrap_or(self.len);
                 if next >= self.len {
                     self.done = true;
-                    self.truncated =
-                        Some(format!("damaged data from byte {start} to the end of the file"));
+                    self.truncated = Some(format!(
+                        "damaged data from byte {start} to the end of the file"
+                    ));
                 }
                 return Ok(Some(self.damaged(
                     start,
@@ -143,8 +150,13 @@ impl Scanner {
                     self.done = true;
                     continue;
                 }
-                op::MESSAGE_INDEX | op::CHUNK_INDEX | op::ATTACHMENT_INDEX | op::METADATA_INDEX
-                | op::STATISTICS | op::SUMMARY_OFFSET | op::HEADER => continue,
+                op::MESSAGE_INDEX
+                | op::CHUNK_INDEX
+                | op::ATTACHMENT_INDEX
+                | op::METADATA_INDEX
+                | op::STATISTICS
+                | op::SUMMARY_OFFSET
+                | op::HEADER => continue,
                 _ => {}
             }
             let what = match opcode {
@@ -175,7 +187,9 @@ impl Scanner {
     fn follows_well(&mut self, at: u64) -> std::io::Result<bool> {
         match self.head_at(at)? {
             Some((op::CHUNK | op::ATTACHMENT, _)) => self.good_at(at, false),
-            Some((o, l)) => Ok(opcode_known(o) && at + RECORD_HEAD + l <= self.len),
+            Some((o, l)) => {
+                Ok(opcode_known(o) && at.saturating_add(RECORD_HEAD).saturating_add(l) <= self.len)
+            }
             None => Ok(at == self.len),
         }
     }
@@ -208,7 +222,7 @@ impl Scanner {
 
     /// Opcode and length of the record at `at`, or `None` if the file ends first.
     fn head_at(&mut self, at: u64) -> std::io::Result<Option<(u8, u64)>> {
-        if at + RECORD_HEAD > self.len {
+        if at.saturating_add(RECORD_HEAD) > self.len {
             return Ok(None);
         }
         self.file.seek(SeekFrom::Start(at))?;
@@ -264,8 +278,8 @@ impl Scanner {
         let Some((opcode, length)) = self.head_at(at)? else {
             return Ok(false);
         };
-        let kind_ok = matches!(opcode, op::CHUNK | op::ATTACHMENT)
-            || (metadata && opcode == op::METADATA);
+        let kind_ok =
+            matches!(opcode, op::CHUNK | op::ATTACHMENT) || (metadata && opcode == op::METADATA);
         if !kind_ok || length > RECORD_LIMIT || at + RECORD_HEAD + length > self.len {
             return Ok(false);
         }
@@ -379,14 +393,51 @@ fn read_record(opcode: u8, body: &[u8]) -> Result<Vec<Record<'static>>, String> 
     if opcode == op::ATTACHMENT && !attachment_fits(body) {
         return Err("its lengths do not fit".into());
     }
-    let record = mcap::parse_record(opcode, body).map_err(|e| describe(&e))?;
-    let Record::Chunk { header, data } = record else {
+    if opcode != op::CHUNK {
+        let record = mcap::parse_record(opcode, body).map_err(|e| describe(&e))?;
         return Ok(vec![record.into_owned()]);
-    };
-    let reader = mcap::read::ChunkReader::new(header, &data).map_err(|e| describe(&e))?;
+    }
+    if let Record::Chunk { header, .. } =
+        mcap::parse_record(opcode, body).map_err(|e| describe(&e))?
+    {
+        if header.uncompressed_size > RECORD_LIMIT {
+            return Err("its uncompressed size is wrong".into());
+        }
+    }
+    // MCAP's linear reader checks the CRC of the whole chunk before it parses any record in it
+    // (garbage that decompresses must never be parsed: its lengths are arbitrary).
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_skip_start_magic(true)
+            .with_prevalidate_chunk_crcs(true)
+            .with_record_length_limit(RECORD_LIMIT as usize),
+    );
+    let mut input: &[u8] = &[];
+    let mut head = [0u8; RECORD_HEAD as usize];
+    head[0] = opcode;
+    head[1..].copy_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut parts = [&head[..], body].into_iter();
     let mut records = Vec::new();
-    for r in reader {
-        records.push(r.map_err(|e| describe(&e))?.into_owned());
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|e| describe(&e))? {
+            LinearReadEvent::ReadRequest(n) => {
+                if input.is_empty() {
+                    match parts.next() {
+                        Some(p) => input = p,
+                        // The whole chunk was read: its records are out.
+                        None => break,
+                    }
+                }
+                let take = n.min(input.len());
+                reader.insert(take).copy_from_slice(&input[..take]);
+                reader.notify_read(take);
+                input = &input[take..];
+            }
+            LinearReadEvent::Record { data, opcode } => {
+                let r = mcap::parse_record(opcode, data).map_err(|e| describe(&e))?;
+                records.push(r.into_owned());
+            }
+        }
     }
     Ok(records)
 }

@@ -12,8 +12,11 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox diff`.
 #[derive(Args, Debug)]
-#[command(after_help = "Exit codes: 0 the recordings agree on everything both recorded, 1 they \
-    differ, 3 one of them is damaged or cut off (and nothing else differs).")]
+#[command(
+    after_help = "Exit codes: 0 the recordings agree on everything both recorded; 1 they \
+    differ (or an error); 2 bad arguments; 3 one of them is damaged or cut off and nothing both \
+    hold differs (steps only one file kept are not compared)."
+)]
 pub struct DiffArgs {
     /// The first recording.
     pub a: PathBuf,

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox export`.
 #[derive(Args, Debug)]
+#[command(after_help = super::replay::EXIT_CODES)]
 pub struct ExportArgs {
     /// The recording (.mcap).
     pub file: PathBuf,

@@ -10,6 +10,7 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox inspect`.
 #[derive(Args, Debug)]
+#[command(after_help = super::replay::EXIT_CODES)]
 pub struct InspectArgs {
     /// The recording (.mcap).
     pub file: PathBuf,

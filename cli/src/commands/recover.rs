@@ -11,6 +11,7 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox recover`.
 #[derive(Args, Debug)]
+#[command(after_help = super::replay::EXIT_CODES)]
 pub struct RecoverArgs {
     /// The cut-off or damaged recording.
     pub file: PathBuf,
@@ -57,7 +58,11 @@ pub fn run(args: &RecoverArgs, out: &mut dyn Write) -> anyhow::Result<()> {
                 "{} damaged stretch(es) left out ({missing} steps missing){}; the copy {} holds \
                  everything else",
                 r.gaps.len(),
-                if r.truncated.is_some() { ", cut off" } else { "" },
+                if r.truncated.is_some() {
+                    ", cut off"
+                } else {
+                    ""
+                },
                 output.display()
             ),
         }

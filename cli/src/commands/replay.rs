@@ -13,8 +13,15 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// The exit codes of the commands that read recordings (`--help`).
+pub const EXIT_CODES: &str = "Exit codes: 0 ok; 1 an error, or a difference (a replay that \
+    departs from its recording, two recordings that differ); 2 bad arguments; 3 the recording is \
+    damaged or cut off: a damaged chunk is skipped and the rest used, the missing steps are \
+    named on stderr.";
+
 /// Arguments of `critterbox replay`.
 #[derive(Args, Debug)]
+#[command(after_help = EXIT_CODES)]
 pub struct ReplayArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
