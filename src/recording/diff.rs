@@ -240,10 +240,9 @@ fn compare_step(
             continue;
         }
         // Keyframe intervals may differ; a step near damage may have lost some messages.
-        if ma.len() != mb.len() && (topic == schema::STATE || lenient) {
-            if ma.is_empty() || mb.is_empty() {
-                continue;
-            }
+        let one_side = ma.is_empty() || mb.is_empty();
+        if one_side && (topic == schema::STATE || lenient) {
+            continue;
         }
         if ma.len() != mb.len() {
             found.push(format!(

@@ -176,22 +176,23 @@ pub fn read_items(
                         })?
                     }
                     mcap::records::Record::Message { header, data } => {
-                        if let Some(c) = spare.remove(&header.channel_id) {
-                            if !channels.contains_key(&c.id) {
-                                let (name, enc, text) = schemas
-                                    .get(&c.schema_id)
-                                    .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
-                                    .unwrap_or(("", "", &[]));
-                                visit(Item::Channel {
-                                    id: c.id,
-                                    topic: &c.topic,
-                                    schema: name,
-                                    schema_encoding: enc,
-                                    schema_data: text,
-                                    message_encoding: &c.message_encoding,
-                                })?;
-                                channels.insert(c.id, c.topic);
-                            }
+                        let lost = spare
+                            .remove(&header.channel_id)
+                            .filter(|c| !channels.contains_key(&c.id));
+                        if let Some(c) = lost {
+                            let (name, enc, text) = schemas
+                                .get(&c.schema_id)
+                                .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
+                                .unwrap_or(("", "", &[]));
+                            visit(Item::Channel {
+                                id: c.id,
+                                topic: &c.topic,
+                                schema: name,
+                                schema_encoding: enc,
+                                schema_data: text,
+                                message_encoding: &c.message_encoding,
+                            })?;
+                            channels.insert(c.id, c.topic);
                         }
                         let topic = channels.get(&header.channel_id).map_or("", String::as_str);
                         visit(Item::Message {

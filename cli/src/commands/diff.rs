@@ -24,6 +24,9 @@ pub struct DiffArgs {
     pub b: PathBuf,
 }
 
+/// How the library starts the line of a full state that differs.
+const STATE_PREFIX: &str = "full state: ";
+
 /// Metadata keys that differ between runs of the same scene without changing it.
 const INCIDENTAL: [&str; 3] = ["created", "command_line", "record_every"];
 
@@ -65,9 +68,17 @@ pub fn run(args: &DiffArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         Some((step, what)) => {
             differs = true;
             let step = *step;
-            writeln!(out, "first differs at step {step}: {}", what[0])?;
-            for w in &what[1..] {
+            // A full state's difference names the critter: it gets the line the hash's would.
+            let (critter, rest): (Vec<&String>, Vec<&String>) =
+                what.iter().partition(|w| w.starts_with(STATE_PREFIX));
+            let head = rest.first().map_or("full state", |w| w.as_str());
+            writeln!(out, "first differs at step {step}: {head}")?;
+            for w in rest.iter().skip(1) {
                 writeln!(out, "             {w}")?;
+            }
+            for c in critter {
+                let c = c.trim_start_matches(STATE_PREFIX);
+                writeln!(out, "first critter (step {step}): {c}")?;
             }
             if report.hash_differs && !report.states_compared {
                 match critter_at(&a, &b, step) {
