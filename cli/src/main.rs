@@ -1,4 +1,7 @@
-//! The `critterbox` command: parses arguments, runs, and maps the outcome to an exit code.
+//! The `critterbox` command: parses arguments, runs, and maps the outcome to an exit code:
+//! 0 ok, 1 an error or a difference (a replay that departs from its recording, two recordings
+//! that differ, a failed test), 2 bad arguments (clap), 3 a recording that is damaged or cut
+//! off (whatever could be read was used and printed first).
 
 mod commands;
 mod plot;
@@ -19,9 +22,23 @@ fn main() -> ExitCode {
         Err(e) => {
             let _ = out.flush(); // what was printed comes before the error
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            if is_damaged_data(&e) {
+                ExitCode::from(DAMAGED_DATA)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
+}
+
+/// The exit code of a command that read a damaged or cut-off recording.
+const DAMAGED_DATA: u8 = 3;
+
+fn is_damaged_data(e: &anyhow::Error) -> bool {
+    matches!(
+        e.downcast_ref::<critterbox::recording::RecordingError>(),
+        Some(critterbox::recording::RecordingError::Damaged { .. })
+    )
 }
 
 fn is_broken_pipe(e: &anyhow::Error) -> bool {

@@ -309,7 +309,7 @@ fn a_cut_off_file_reads_up_to_its_last_complete_chunk_and_recovers() {
     let kept = r.last_step();
     assert!(kept > 0 && kept < 60, "kept {kept} steps");
     let o = critterbox(&["replay", cut.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(o.status.code(), Some(3), "cut off: {}", text(&o));
     assert!(text(&o).contains("cut off"), "{}", text(&o));
 
     let fixed = dir.join("fixed.mcap");
@@ -319,7 +319,12 @@ fn a_cut_off_file_reads_up_to_its_last_complete_chunk_and_recovers() {
         "-o",
         fixed.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "the source lacked data: {}",
+        text(&o)
+    );
     assert!(text(&o).contains("recovered"), "{}", text(&o));
     let r2 = Recording::open(&fixed).expect("open recovered");
     assert_eq!(r2.truncated, None, "the recovered file is complete");
@@ -370,7 +375,7 @@ fn a_killed_run_leaves_a_recoverable_file_and_ctrl_c_finishes_it() {
     let r = Recording::open(&dir.join("killed.mcap")).expect("readable after SIGKILL");
     assert!(r.end.is_none() && r.last_step() > 0);
     let o = critterbox(&["recover", dir.join("killed.mcap").to_str().unwrap()]);
-    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(o.status.code(), Some(3), "cut off: {}", text(&o));
     let r2 = Recording::open(&dir.join("killed.recovered.mcap")).expect("recovered");
     assert_eq!(
         (r2.truncated.clone(), r2.last_step()),
@@ -841,7 +846,7 @@ fn a_kind_loaded_mid_run_survives_a_killed_run() {
     child.wait().expect("wait");
 
     let o = critterbox(&["recover", file.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(o.status.code(), Some(3), "cut off: {}", text(&o));
     let recovered = dir.join("late.recovered.mcap");
     let r = Recording::open(&recovered).expect("recovered");
     assert!(

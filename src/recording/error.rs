@@ -25,6 +25,14 @@ pub enum RecordingError {
         /// The file.
         path: PathBuf,
     },
+    /// Part of the file could not be read (damaged or cut off); what could be read was used.
+    #[error("{path} is damaged or incomplete: {what}")]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// Which steps are missing and why.
+        what: String,
+    },
     /// An MCAP file, but not one critterbox wrote.
     #[error("{path} is an MCAP file but not a critterbox recording: {reason}")]
     NotCritterbox {

@@ -11,12 +11,13 @@
 //!   exactly by re-simulating, and [`verify`] proves a file by re-simulating all of it.
 //! - **Off the simulation thread.** [`writer::Recorder`] captures on the simulation thread and
 //!   encodes and compresses on its own thread.
-//! - **Crash safe.** Chunks are closed every few hundred milliseconds; [`reader`] uses the
-//!   streaming reader, so cut-off files read up to their last complete chunk and [`recover`]
-//!   rewrites them whole.
+//! - **Crash safe.** Chunks are closed every few hundred milliseconds; [`reader`] walks the file
+//!   record by record ([`scan`]), so cut-off files read up to their last complete chunk, a
+//!   damaged chunk loses only itself, and [`recover`] rewrites what is left whole.
 
 pub mod capture;
 pub mod compare;
+pub mod diff;
 mod error;
 pub mod export;
 pub mod foxglove;
@@ -27,6 +28,7 @@ pub mod reader;
 pub mod rebuild;
 pub mod recover;
 pub mod replay;
+pub mod scan;
 pub mod schema;
 pub mod verify;
 pub mod writer;

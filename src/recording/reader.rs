@@ -1,11 +1,13 @@
-//! Reading recordings with MCAP's streaming (linear) reader, which also reads files that were
-//! cut short: everything up to the last complete chunk comes back, and the reason reading
-//! stopped is kept. (The summary-based reader needs the footer, which a killed run never wrote.)
+//! Reading recordings record by record ([`super::scan`]), which also reads files that were cut
+//! short or damaged: everything up to the last complete chunk comes back, a damaged chunk is
+//! skipped and reported, and the reason reading stopped early is kept. (The summary-based
+//! reader needs the footer, which a killed run never wrote.)
 
 use super::error::{with_causes, RecordingError};
 use super::meta::{EndMeta, RunMeta};
+pub use super::scan::Damage;
+use super::scan::{Event, Scanner};
 use super::schema::{self, ErrorMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg};
-use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::Read;
@@ -63,6 +65,8 @@ pub enum Item<'a> {
         /// Payload (JSON for critterbox channels).
         data: &'a [u8],
     },
+    /// A damaged stretch of the file was skipped; reading goes on after it.
+    Damaged(&'a Damage),
 }
 
 /// Whether to go on reading.
@@ -81,15 +85,15 @@ pub struct ReadEnd {
     pub truncated: Option<String>,
     /// True when the visitor asked to stop.
     pub stopped: bool,
+    /// Damaged stretches skipped (each also visited as [`Item::Damaged`]).
+    pub damaged: Vec<Damage>,
 }
 
-/// Bigger records than this are taken as damage (a recording's chunks are about 1 MiB).
-const RECORD_LIMIT: usize = 1 << 30;
-
 /// Reads `path` from the start, calling `visit` for each record, in file order. Records of a
-/// chunk come only once the whole chunk has been read and its CRC checked, so a cut-off chunk
-/// yields nothing. Errors before any record was read mean the file is not a recording; later
-/// ones end reading with [`ReadEnd::truncated`] set.
+/// chunk come only once the whole chunk has been read and its CRC checked, so a cut-off or
+/// damaged chunk yields nothing; a damaged one is visited as [`Item::Damaged`] and reading goes
+/// on with the next good record. A file that does not start as MCAP is an error; one that ends
+/// early has [`ReadEnd::truncated`] set.
 pub fn read_items(
     path: &Path,
     mut visit: impl FnMut(Item<'_>) -> Result<Flow, RecordingError>,
@@ -106,38 +110,36 @@ pub fn read_items(
             path: path.to_path_buf(),
         });
     }
-    let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_skip_start_magic(true)
-            .with_prevalidate_chunk_crcs(true)
-            .with_record_length_limit(RECORD_LIMIT),
-    );
+    let mut scanner = Scanner::new(file).map_err(io)?;
     // Channels by id: (topic, schema name).
     let mut schemas: BTreeMap<u16, (String, String, Vec<u8>)> = BTreeMap::new();
     let mut channels: BTreeMap<u16, String> = BTreeMap::new();
     let mut end = ReadEnd::default();
-    while let Some(event) = reader.next_event() {
-        let event = match event {
-            Ok(e) => e,
-            Err(e) => {
-                end.truncated = Some(describe(&e));
-                break;
+    // The summary's copies stand in for channel records lost with a damaged chunk.
+    let mut spare: BTreeMap<u16, mcap::records::Channel> = BTreeMap::new();
+    for r in scanner.summary_channels() {
+        match r {
+            mcap::records::Record::Schema { header, data } => {
+                let entry = (header.name.clone(), header.encoding.clone(), data.to_vec());
+                schemas.entry(header.id).or_insert(entry);
             }
-        };
+            mcap::records::Record::Channel(c) => {
+                spare.insert(c.id, c.clone());
+            }
+            _ => {}
+        }
+    }
+    while let Some(event) = scanner.next_event().map_err(io)? {
         match event {
-            LinearReadEvent::ReadRequest(n) => {
-                let buf = reader.insert(n);
-                let read = file.read(buf).map_err(io)?;
-                reader.notify_read(read);
+            Event::Damaged(damage) => {
+                let flow = visit(Item::Damaged(&damage))?;
+                end.damaged.push(damage);
+                if flow == Flow::Stop {
+                    end.stopped = true;
+                    break;
+                }
             }
-            LinearReadEvent::Record { data, opcode } => {
-                let record = match mcap::parse_record(opcode, data) {
-                    Ok(r) => r,
-                    Err(e) => {
-                        end.truncated = Some(format!("a damaged record: {e}"));
-                        break;
-                    }
-                };
+            Event::Record(record) => {
                 let flow = match record {
                     mcap::records::Record::Schema { header, data } => {
                         schemas
@@ -174,6 +176,24 @@ pub fn read_items(
                         })?
                     }
                     mcap::records::Record::Message { header, data } => {
+                        let lost = spare
+                            .remove(&header.channel_id)
+                            .filter(|c| !channels.contains_key(&c.id));
+                        if let Some(c) = lost {
+                            let (name, enc, text) = schemas
+                                .get(&c.schema_id)
+                                .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
+                                .unwrap_or(("", "", &[]));
+                            visit(Item::Channel {
+                                id: c.id,
+                                topic: &c.topic,
+                                schema: name,
+                                schema_encoding: enc,
+                                schema_data: text,
+                                message_encoding: &c.message_encoding,
+                            })?;
+                            channels.insert(c.id, c.topic);
+                        }
                         let topic = channels.get(&header.channel_id).map_or("", String::as_str);
                         visit(Item::Message {
                             topic,
@@ -193,6 +213,9 @@ pub fn read_items(
             }
         }
     }
+    if !end.stopped {
+        end.truncated = scanner.truncated().map(str::to_string);
+    }
     Ok(end)
 }
 
@@ -205,15 +228,6 @@ fn read_full(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
         }
     }
     Ok(got)
-}
-
-fn describe(e: &mcap::McapError) -> String {
-    match e {
-        mcap::McapError::UnexpectedEof => {
-            "the file ends in the middle of a record (cut off: a crash or a kill?)".to_string()
-        }
-        other => format!("damaged data: {other}"),
-    }
 }
 
 /// Decodes a JSON message of `topic`, naming the topic on failure.
@@ -282,6 +296,53 @@ pub struct Recording {
     pub messages: BTreeMap<String, u64>,
     /// Why reading stopped early, for a cut-off or damaged file.
     pub truncated: Option<String>,
+    /// Damaged stretches skipped, with the steps around them.
+    pub gaps: Vec<Gap>,
+    /// For a copy `critterbox recover` made: the file it was made from.
+    pub recovered: Option<String>,
+}
+
+/// A damaged stretch of a recording and the steps it took with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gap {
+    /// What was damaged.
+    pub damage: Damage,
+    /// The last step whose hash was read before the damage (`None`: none was).
+    pub after: Option<u64>,
+    /// The first step whose hash was read after it (`None`: none was).
+    pub resumed: Option<u64>,
+}
+
+impl Gap {
+    /// The steps none of whose hash was read, first and last; `last` is `None` when no step was
+    /// read after the damage. `None` when the damage fell between two consecutive steps (it
+    /// may still have held some of the earlier step's events).
+    pub fn missing(&self) -> Option<(u64, Option<u64>)> {
+        let first = self.after.map_or(0, |a| a + 1);
+        match self.resumed {
+            Some(r) if r <= first => None,
+            Some(r) => Some((first, Some(r - 1))),
+            None => Some((first, None)),
+        }
+    }
+}
+
+impl std::fmt::Display for Gap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.missing() {
+            Some((a, Some(b))) if a == b => write!(f, "step {a} missing: {}", self.damage),
+            Some((a, Some(b))) => write!(f, "steps {a}..{b} missing: {}", self.damage),
+            Some((a, None)) => write!(f, "steps from {a} on missing: {}", self.damage),
+            None => match self.after {
+                Some(a) => write!(
+                    f,
+                    "no whole step missing (step {a} may lack events): {}",
+                    self.damage
+                ),
+                None => write!(f, "no step missing: {}", self.damage),
+            },
+        }
+    }
 }
 
 impl Recording {
@@ -297,6 +358,99 @@ impl Recording {
             });
         }
         Ok(())
+    }
+
+    /// True when part of the file could not be read (damaged or cut off), or steps are missing
+    /// from it (a copy `recover` made of a damaged file).
+    pub fn is_damaged(&self) -> bool {
+        self.truncated.is_some() || !self.gaps.is_empty() || self.missing_steps() > 0
+    }
+
+    /// The runs of steps, up to the last one read, that have no hash in the file: first and
+    /// last of each.
+    pub fn missing_ranges(&self) -> Vec<(u64, u64)> {
+        let mut ranges = Vec::new();
+        let mut next = 0;
+        for &s in self.hashes.keys() {
+            if s > next {
+                ranges.push((next, s - 1));
+            }
+            next = s + 1;
+        }
+        ranges
+    }
+
+    /// One line per damaged stretch, per run of missing steps no damage here explains (a
+    /// recovered copy), and for a cut-off end (empty for an intact file).
+    pub fn damage_report(&self) -> Vec<String> {
+        let mut lines: Vec<String> = self.gaps.iter().map(Gap::to_string).collect();
+        let explained = |&(a, b): &(u64, u64)| {
+            self.gaps
+                .iter()
+                .filter_map(Gap::missing)
+                .any(|(x, y)| x <= a && y.is_none_or(|y| b <= y))
+        };
+        for (a, b) in self.missing_ranges() {
+            if !explained(&(a, b)) {
+                let steps = if a == b {
+                    format!("step {a} is")
+                } else {
+                    format!("steps {a}..{b} are")
+                };
+                lines.push(format!(
+                    "{steps} missing from the file{}",
+                    self.recovered_note()
+                ));
+            }
+        }
+        if let Some(t) = &self.truncated {
+            lines.push(format!("cut off after step {}: {t}", self.last_step()));
+        }
+        lines
+    }
+
+    /// Steps up to the last one read whose hash is not in the file (lost to damage).
+    pub fn missing_steps(&self) -> u64 {
+        if self.hashes.is_empty() {
+            return 0;
+        }
+        self.last_step() + 1 - self.hashes.len() as u64
+    }
+
+    /// The error a command returns, after its output, when part of the file could not be read
+    /// (`None` for an intact file); [`Recording::damage_report`] has the details.
+    pub fn damage_error(&self) -> Option<RecordingError> {
+        if !self.is_damaged() {
+            return None;
+        }
+        let mut what = Vec::new();
+        if !self.gaps.is_empty() {
+            what.push(format!(
+                "{} damaged stretch{} skipped",
+                self.gaps.len(),
+                if self.gaps.len() == 1 { "" } else { "es" },
+            ));
+        }
+        if self.missing_steps() > 0 {
+            what.push(format!("{} steps missing", self.missing_steps()));
+        }
+        if self.truncated.is_some() {
+            what.push(format!("cut off after step {}", self.last_step()));
+        }
+        Some(RecordingError::Damaged {
+            path: self.path.clone(),
+            what: format!(
+                "{}; what could be read was used (`critterbox recover` writes a readable copy)",
+                what.join(", ")
+            ),
+        })
+    }
+
+    /// For a copy `recover` made: where from and why.
+    fn recovered_note(&self) -> String {
+        self.recovered.as_ref().map_or(String::new(), |from| {
+            format!(" (it was recovered from {from})")
+        })
     }
 
     /// Reads a recording; a file that is not one is a clear error.
@@ -316,6 +470,9 @@ impl Recording {
                         }
                     })?);
                 }
+                Item::Metadata { name, map } if name == schema::RECOVERED => {
+                    rec.recovered = map.get("from").cloned();
+                }
                 Item::Metadata { name, map } if name == schema::END => {
                     rec.end = Some(EndMeta::from_map(map));
                 }
@@ -328,6 +485,11 @@ impl Recording {
                     let text = String::from_utf8_lossy(data).into_owned();
                     rec.scripts.push((name.to_string(), text));
                 }
+                Item::Damaged(damage) => rec.gaps.push(Gap {
+                    damage: damage.clone(),
+                    after: rec.hashes.keys().next_back().copied(),
+                    resumed: None,
+                }),
                 Item::Message { topic, data, .. } => {
                     if rec.meta.is_none() {
                         return Err(RecordingError::NotCritterbox {
@@ -349,6 +511,7 @@ impl Recording {
             Err(e) if rec.meta.is_some() && !is_about_the_file(&e) => ReadEnd {
                 truncated: Some(with_causes(&e)),
                 stopped: true,
+                damaged: Vec::new(),
             },
             Err(e) => return Err(e),
         };
@@ -376,6 +539,9 @@ impl Recording {
                         hash: m.hash.clone(),
                     })?;
                 self.hashes.insert(m.step, hash);
+                for g in self.gaps.iter_mut().filter(|g| g.resumed.is_none()) {
+                    g.resumed = Some(m.step);
+                }
             }
             schema::TOTALS => self.totals.push(decode(topic, data)?),
             schema::STATE => {

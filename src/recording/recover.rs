@@ -1,6 +1,7 @@
 //! Rewriting a recording record by record: `critterbox recover` makes a complete, indexed file
-//! from a cut-off one (the complete chunks' messages, every attachment and metadata record
-//! before the cut), and tests use the same copy to alter one message.
+//! from a cut-off or damaged one (the good chunks' messages, every readable attachment and
+//! metadata record; damaged chunks are left out and named), and tests use the same copy to
+//! alter one message.
 
 use super::error::RecordingError;
 use super::reader::{read_items, Flow, Item};
@@ -28,10 +29,20 @@ pub struct Rewritten {
     pub truncated: Option<String>,
     /// True when the source had its end record.
     pub had_end: bool,
+    /// The source's damaged stretches, left out, with the steps they took.
+    pub gaps: Vec<super::reader::Gap>,
+}
+
+impl Rewritten {
+    /// True when the source was cut off or damaged (so the copy lacks something).
+    pub fn lost_data(&self) -> bool {
+        self.truncated.is_some() || !self.gaps.is_empty()
+    }
 }
 
 /// Copies `src` to `dst`, passing each message through `edit(topic, data)` (return `None` to
-/// keep it as is). When `src` was cut off, a `critterbox.recovered` metadata record says so.
+/// keep it as is). When `src` was cut off or damaged, a `critterbox.recovered` metadata record
+/// says so.
 pub fn rewrite(
     src: &Path,
     dst: &Path,
@@ -43,7 +54,7 @@ pub fn rewrite(
         });
     }
     // Check it is a recording before creating anything.
-    let _ = super::reader::Recording::open(src)?;
+    let source = super::reader::Recording::open(src)?;
     let file = File::create(dst).map_err(|error| RecordingError::CannotCreate {
         path: dst.to_path_buf(),
         error,
@@ -58,6 +69,7 @@ pub fn rewrite(
     let mut out = Rewritten::default();
     let end = read_items(src, |item| {
         match item {
+            Item::Damaged(_) => {}
             Item::Channel {
                 id,
                 topic,
@@ -134,12 +146,15 @@ pub fn rewrite(
         Ok(Flow::Continue)
     })?;
     out.truncated = end.truncated;
-    if let Some(reason) = &out.truncated {
+    out.gaps = source.gaps;
+    if out.lost_data() {
+        let mut reasons: Vec<String> = out.gaps.iter().map(|g| g.to_string()).collect();
+        reasons.extend(out.truncated.clone());
         w.write_metadata(&Metadata {
             name: schema::RECOVERED.into(),
             metadata: BTreeMap::from([
                 ("from".to_string(), src.display().to_string()),
-                ("reason".to_string(), reason.clone()),
+                ("reason".to_string(), reasons.join("; ")),
                 (
                     "last_step".to_string(),
                     out.last_step.map_or(String::new(), |s| s.to_string()),

@@ -1,7 +1,9 @@
-//! `critterbox diff A B`: the first step and critter where two recordings differ.
+//! `critterbox diff A B`: what two recordings recorded, compared message by message: the first
+//! step, critter and field that differ, with both values.
 
 use clap::Args;
 use critterbox::recording::compare::first_difference;
+use critterbox::recording::diff::diff;
 use critterbox::recording::reader::state_at;
 use critterbox::recording::replay::state_at_step;
 use critterbox::recording::Recording;
@@ -10,6 +12,11 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox diff`.
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Exit codes: 0 the recordings agree on everything both recorded; 1 they \
+    differ (or an error); 2 bad arguments; 3 one of them is damaged or cut off and nothing both \
+    hold differs (steps only one file kept are not compared)."
+)]
 pub struct DiffArgs {
     /// The first recording.
     pub a: PathBuf,
@@ -17,14 +24,19 @@ pub struct DiffArgs {
     pub b: PathBuf,
 }
 
+/// How the library starts the line of a full state that differs.
+const STATE_PREFIX: &str = "full state: ";
+
 /// Metadata keys that differ between runs of the same scene without changing it.
 const INCIDENTAL: [&str; 3] = ["created", "command_line", "record_every"];
 
-/// Runs the command: exit 0 when the recordings agree on every step's hash, non-zero when they
-/// differ (after printing where).
+/// Runs the command: metadata, scripts, then every step's hash, totals, events and (where both
+/// have one) full state. Exits 0 when all agree, 1 when something differs (after printing the
+/// first step that does), 3 when a file is damaged and nothing else differs.
 pub fn run(args: &DiffArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let a = Recording::open(&args.a)?;
     let b = Recording::open(&args.b)?;
+    let mut differs = false;
     let keys: std::collections::BTreeSet<&String> =
         a.meta_map.keys().chain(b.meta_map.keys()).collect();
     for k in keys {
@@ -32,43 +44,68 @@ pub fn run(args: &DiffArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         if x != y && !INCIDENTAL.contains(&k.as_str()) {
             let show = |v: Option<&String>| v.map_or("(none)".to_string(), |v| v.clone());
             writeln!(out, "metadata     {k}: {} | {}", show(x), show(y))?;
+            differs = true;
         }
     }
-    let (la, lb) = (a.last_step(), b.last_step());
-    let first = (0..=la.max(lb)).find(|s| a.hashes.get(s) != b.hashes.get(s));
-    let Some(step) = first else {
-        writeln!(out, "same         {} steps, every state hash equal", la + 1)?;
-        return Ok(());
-    };
-    let (ha, hb) = (a.hashes.get(&step), b.hashes.get(&step));
-    let hex = |h: Option<&u64>| h.map_or("(no step)".to_string(), |h| format!("{h:016x}"));
-    writeln!(
-        out,
-        "first differs at step {step}: state hash {} | {}",
-        hex(ha),
-        hex(hb)
-    )?;
-    if ha.is_some() && hb.is_some() {
-        match critter_at(&a, &b, step) {
-            Ok(Some(d)) => writeln!(out, "first critter {d}")?,
-            Ok(None) => writeln!(
+    let report = diff(&a, &b)?;
+    for s in &report.scripts {
+        writeln!(out, "{s}")?;
+        differs = true;
+    }
+    match &report.first {
+        None => {
+            let unchecked = match report.unchecked {
+                0 => String::new(),
+                n => format!(" ({n} steps only one file kept were not compared)"),
+            };
+            writeln!(
                 out,
-                "the critters are equal; the difference is in the step count, dt or the random generator"
-            )?,
-            Err(e) => writeln!(out, "no critter named: {e:#}")?,
+                "same         {} steps, every state hash equal, and every total, event, log line \
+                 and full state both recorded{unchecked}",
+                report.steps
+            )?;
         }
-    } else {
-        writeln!(
-            out,
-            "one recording ends at step {}, the other at step {}",
-            la, lb
-        )?;
+        Some((step, what)) => {
+            differs = true;
+            let step = *step;
+            // A full state's difference names the critter: it gets the line the hash's would.
+            let (critter, rest): (Vec<&String>, Vec<&String>) =
+                what.iter().partition(|w| w.starts_with(STATE_PREFIX));
+            let head = rest.first().map_or("full state", |w| w.as_str());
+            writeln!(out, "first differs at step {step}: {head}")?;
+            for w in rest.iter().skip(1) {
+                writeln!(out, "             {w}")?;
+            }
+            for c in critter {
+                let c = c.trim_start_matches(STATE_PREFIX);
+                writeln!(out, "first critter (step {step}): {c}")?;
+            }
+            if report.hash_differs && !report.states_compared {
+                match critter_at(&a, &b, step) {
+                    Ok(Some(d)) => writeln!(out, "first critter {d}")?,
+                    Ok(None) => writeln!(
+                        out,
+                        "the critters are equal; the difference is in the step count, dt or the random generator"
+                    )?,
+                    Err(e) => writeln!(out, "no critter named: {e:#}")?,
+                }
+            }
+        }
     }
-    anyhow::bail!(
-        "{} and {} differ from step {step}",
-        args.a.display(),
-        args.b.display()
-    )
+    if differs {
+        for r in [&a, &b] {
+            super::replay::warn_damage(r);
+        }
+        let at = report
+            .first
+            .as_ref()
+            .map_or("in their scripts or metadata".to_string(), |(s, _)| {
+                format!("from step {s}")
+            });
+        anyhow::bail!("{} and {} differ {at}", args.a.display(), args.b.display())
+    }
+    super::replay::damage_outcome(&a)?;
+    super::replay::damage_outcome(&b)
 }
 
 /// The first critter that differs at `step`: from the recorded states when both have one, else

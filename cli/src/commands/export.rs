@@ -8,6 +8,7 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox export`.
 #[derive(Args, Debug)]
+#[command(after_help = super::replay::EXIT_CODES)]
 pub struct ExportArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
@@ -28,8 +29,5 @@ pub fn run(args: &ExportArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out, "{:<40} {rows} rows", path.display())?;
     }
     writeln!(out, "states       {} steps", done.states)?;
-    if let Some(t) = &done.truncated {
-        writeln!(out, "warning      the file is cut off: {t}")?;
-    }
-    Ok(())
+    super::replay::damage_outcome(&rec)
 }

@@ -1,7 +1,7 @@
 //! `critterbox inspect FILE`: what a recording holds: scene, steps, critters by kind, collisions,
 //! deaths, and energy and momentum over time as a table (`--plot` draws them).
 
-use super::replay::{sample, summary_head};
+use super::replay::{damage_outcome, sample, summary_head};
 use crate::plot;
 use clap::Args;
 use critterbox::recording::Recording;
@@ -10,6 +10,7 @@ use std::path::PathBuf;
 
 /// Arguments of `critterbox inspect`.
 #[derive(Args, Debug)]
+#[command(after_help = super::replay::EXIT_CODES)]
 pub struct InspectArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
@@ -115,12 +116,9 @@ pub fn run(args: &InspectArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out, "{line}")?;
         prev = t.step;
     }
-    if let Some(t) = &rec.truncated {
-        writeln!(out, "warning      the file is cut off: {t}")?;
-    }
     if let Some(path) = &args.plot {
         plot::totals_chart(&rec, path)?;
         writeln!(out, "plot         {}", path.display())?;
     }
-    Ok(())
+    damage_outcome(&rec)
 }

@@ -39,11 +39,11 @@ pub enum Command {
     Replay(replay::ReplayArgs),
     /// Show what a recording holds: scene, critters, collisions, energy and momentum over time.
     Inspect(inspect::InspectArgs),
-    /// Show the first step and critter where two recordings differ.
+    /// Compare what two recordings recorded: the first step, critter and field that differ.
     Diff(diff::DiffArgs),
     /// Write a recording's states and events as CSV files.
     Export(export::ExportArgs),
-    /// Make a readable, complete file from a cut-off recording (complete chunks kept).
+    /// Make a readable, complete file from a cut-off or damaged recording (good chunks kept).
     Recover(recover::RecoverArgs),
     /// Chart cost against error for every method; writes docs/speed-vs-accuracy.svg and .png.
     Chart(chart::ChartArgs),

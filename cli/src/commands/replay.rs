@@ -13,8 +13,15 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// The exit codes of the commands that read recordings (`--help`).
+pub const EXIT_CODES: &str = "Exit codes: 0 ok; 1 an error, or a difference (a replay that \
+    departs from its recording, two recordings that differ); 2 bad arguments; 3 the recording is \
+    damaged or cut off: a damaged chunk is skipped and the rest used, the missing steps are \
+    named on stderr.";
+
 /// Arguments of `critterbox replay`.
 #[derive(Args, Debug)]
+#[command(after_help = EXIT_CODES)]
 pub struct ReplayArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
@@ -65,7 +72,7 @@ pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             writeln!(out, "step {step} (t = {}): {how}", state.time.0)?;
             print_state(out, &state)?;
         }
-        return warn_truncated(&rec, out);
+        return damage_outcome(&rec);
     }
     summary(&rec, out, args.rows)?;
     if args.view.wanted() {
@@ -73,36 +80,61 @@ pub fn run(args: &ReplayArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     }
     if args.verify {
         let report = verify(&rec, |_| {})?;
-        match &report.mismatch {
-            None => {
-                writeln!(
-                    out,
-                    "verify       ok: {} steps re-simulated from the recording alone; {} hashes, {} full states and {} event messages identical{}",
-                    report.steps,
-                    report.hashes,
-                    report.states,
-                    report.events,
-                    report
-                        .error_reproduced
-                        .map_or(String::new(), |s| format!("; the error in step {s} reproduced"))
-                )?;
+        if let Some(m) = &report.mismatch {
+            writeln!(out, "verify       MISMATCH at step {}: {}", m.step, m.what)?;
+            match &m.critter {
+                Some((at, c)) => writeln!(out, "first critter that differs (step {at}): {c}")?,
+                None => writeln!(out, "no recorded full state after it to name a critter")?,
             }
-            Some(m) => {
-                writeln!(out, "verify       MISMATCH at step {}: {}", m.step, m.what)?;
-                match &m.critter {
-                    Some((at, c)) => writeln!(out, "first critter that differs (step {at}): {c}")?,
-                    None => writeln!(out, "no recorded full state after it to name a critter")?,
-                }
-                warn_truncated(&rec, out)?;
-                anyhow::bail!(
-                    "{}: the replay differs from the recording at step {}",
-                    args.file.display(),
-                    m.step
-                );
+            warn_damage(&rec);
+            anyhow::bail!(
+                "{}: the replay differs from the recording at step {}",
+                args.file.display(),
+                m.step
+            );
+        }
+        let checked = format!(
+            "{} steps re-simulated from the recording alone; {} hashes, {} full states and {} event messages identical{}",
+            report.steps,
+            report.hashes,
+            report.states,
+            report.events,
+            report
+                .error_reproduced
+                .map_or(String::new(), |s| format!("; the error in step {s} reproduced"))
+        );
+        if rec.is_damaged() {
+            // Steps missing from the file were re-simulated but not checked against it.
+            let mut unchecked = Vec::new();
+            if rec.missing_steps() > 0 {
+                unchecked.push(format!(
+                    "{} steps missing from the file could not be checked",
+                    rec.missing_steps()
+                ));
+            } else if !rec.gaps.is_empty() {
+                unchecked.push("part of the file is damaged".to_string());
             }
+            if rec.truncated.is_some() {
+                unchecked.push(format!(
+                    "the file is cut off after step {}, so the steps after it could not be checked",
+                    rec.last_step()
+                ));
+            }
+            writeln!(
+                out,
+                "verify       incomplete: {checked}; {}",
+                unchecked.join("; ")
+            )?;
+        } else if report.hashes == 0 {
+            anyhow::bail!(
+                "{}: nothing to verify: the file holds no step hash",
+                args.file.display()
+            );
+        } else {
+            writeln!(out, "verify       ok: {checked}")?;
         }
     }
-    warn_truncated(&rec, out)
+    damage_outcome(&rec)
 }
 
 /// Re-simulates the recorded run from the file and sends every step to the viewer. Stops at the
@@ -169,15 +201,21 @@ fn to_viewer(
     Ok(())
 }
 
-fn warn_truncated(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> {
-    if let Some(t) = &rec.truncated {
-        writeln!(
-            out,
-            "warning      the file is cut off after step {}: {t} (`critterbox recover` writes a complete copy)",
-            rec.last_step()
-        )?;
+/// Warns on stderr about each damaged stretch of the file and a cut-off end.
+pub fn warn_damage(rec: &Recording) {
+    for line in rec.damage_report() {
+        eprintln!("warning: {line}");
     }
-    Ok(())
+}
+
+/// After a command's output: warnings on stderr and the damaged-data error (exit code 3) when
+/// part of the file could not be read.
+pub fn damage_outcome(rec: &Recording) -> anyhow::Result<()> {
+    warn_damage(rec);
+    match rec.damage_error() {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
 }
 
 fn fnum(x: f64) -> String {
@@ -225,9 +263,13 @@ pub fn summary_head(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> 
         (Some(e), _) => e.outcome.clone(),
         (None, _) => "no end record (the run did not finish writing)".into(),
     };
+    let missing = match rec.missing_steps() {
+        0 => String::new(),
+        n => format!("; {n} of them missing from the file (damaged)"),
+    };
     writeln!(
         out,
-        "steps        {} of {} asked ({ended})",
+        "steps        {} of {} asked ({ended}){missing}",
         rec.last_step(),
         m.steps
     )?;
