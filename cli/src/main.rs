@@ -19,7 +19,11 @@ fn main() -> ExitCode {
         Err(e) => {
             let _ = out.flush(); // what was printed comes before the error
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            match e.downcast_ref::<commands::record::Interrupted>() {
+                // 128 + the signal, as a shell reports a process the signal ended.
+                Some(i) => ExitCode::from(i.exit_code()),
+                None => ExitCode::FAILURE,
+            }
         }
     }
 }
