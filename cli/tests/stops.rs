@@ -70,7 +70,7 @@ fn interrupt_with(signal: &str, number: i32) {
         out.contains(&format!("ended: interrupted ({name})")),
         "{out}"
     );
-    assert!(out.contains(&format!("interrupted by ")), "{out}");
+    assert!(out.contains("interrupted by "), "{out}");
     assert!(out.contains(&name), "{out}");
 
     let rec = Recording::open(&file).expect("open");
@@ -243,5 +243,15 @@ fn a_mistyped_scene_or_path_writes_no_file() {
         let o = critterbox_in(&dir, args);
         assert!(!o.status.success(), "{}", text(&o));
         assert!(!dir.join("recordings").exists(), "{}", text(&o));
+    }
+}
+
+#[test]
+fn run_help_gives_the_exit_codes_of_the_signals() {
+    let o = critterbox_in(&tmp("help"), &["run", "--help"]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    for code in ["SIGINT (130)", "SIGTERM (143)", "SIGHUP (129)"] {
+        assert!(out.contains(code), "{out}");
     }
 }

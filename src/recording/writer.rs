@@ -285,13 +285,19 @@ impl Drop for Recorder {
     }
 }
 
+/// The MCAP writer of a recording's file.
+type McapFile = mcap::Writer<BufWriter<File>>;
+
+/// Channel ids by topic.
+type Channels = BTreeMap<&'static str, u16>;
+
 /// Creates the file and writes the metadata, the schemas and channels, and the script
 /// attachments, flushed so that they survive a kill.
 fn open(
     path: &Path,
     meta: &RunMeta,
     sources: &[SourceFile],
-) -> Result<(mcap::Writer<BufWriter<File>>, BTreeMap<&'static str, u16>), RecordingError> {
+) -> Result<(McapFile, Channels), RecordingError> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| write_err(path, e))?;
     }
@@ -385,8 +391,8 @@ fn attach<W: std::io::Write + std::io::Seek>(
 
 /// The writer thread's side.
 struct Output {
-    w: mcap::Writer<BufWriter<File>>,
-    channels: BTreeMap<&'static str, u16>,
+    w: McapFile,
+    channels: Channels,
     sequence: BTreeMap<u16, u32>,
     colors: Vec<foxglove::Rgba>,
     last_log_time: u64,

@@ -11,6 +11,12 @@ use std::time::{Duration, Instant};
 
 /// Arguments of `critterbox run`.
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Exit codes: 0 when the run completed or the scene stopped it; 1 on an \
+error (a scene that cannot be built is still recorded, with its scripts and the error); \
+128 + the signal when SIGINT (130), SIGTERM (143) or SIGHUP (129) stopped it after the current \
+step, with the recording finished (end record `interrupted`, naming the signal)."
+)]
 pub struct RunArgs {
     /// A scene script (scripts/scenes/NAME.rhai) or a built-in scene (see --list). Default: gas.
     pub scene: Option<String>,
