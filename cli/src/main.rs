@@ -22,7 +22,10 @@ fn main() -> ExitCode {
         Err(e) => {
             let _ = out.flush(); // what was printed comes before the error
             eprintln!("error: {e:#}");
-            if is_damaged_data(&e) {
+            if let Some(i) = e.downcast_ref::<commands::record::Interrupted>() {
+                // 128 + the signal, as a shell reports a process the signal ended.
+                ExitCode::from(i.exit_code())
+            } else if is_damaged_data(&e) {
                 ExitCode::from(DAMAGED_DATA)
             } else {
                 ExitCode::FAILURE

@@ -126,6 +126,47 @@ impl RunMeta {
     }
 }
 
+/// The outcome of a run whose scene could not be built ([`EndMeta::outcome`]).
+pub const SETUP_FAILED: &str = "setup_failed";
+
+impl RunMeta {
+    /// How a run was asked for whose scene could not be built: `scene` is the name asked for and
+    /// `file` its script, if it is one. What only the built world would tell (dimension, border,
+    /// method, critters) is written as unknown: `dim` 0, `border` and `method` `unknown` (or the
+    /// `--method` asked for).
+    pub fn for_failed_setup(
+        scene: &str,
+        file: Option<&str>,
+        method: Option<String>,
+        overrides: &RunOverrides,
+    ) -> RunMeta {
+        let source = match file {
+            Some(f) => SceneSource::Script { file: f.into() },
+            None => SceneSource::Builtin,
+        };
+        RunMeta {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.to_string(),
+            source,
+            seed: overrides.seed.unwrap_or(0),
+            seed_override: overrides.seed,
+            dt: overrides.dt.unwrap_or(0.0),
+            dt_override: overrides.dt,
+            steps: overrides.steps.unwrap_or(0),
+            method: method.unwrap_or_else(|| "unknown".into()),
+            dim: 0,
+            border: "unknown".into(),
+            n: overrides.n,
+            sets: overrides.sets.clone(),
+            limits: overrides.limits.clone(),
+            command_line: std::env::args().collect(),
+            record_every: overrides.record_every.unwrap_or(1),
+            critters: 0,
+            created: utc_now().1,
+        }
+    }
+}
+
 fn float(x: f64) -> String {
     let mut b = ryu::Buffer::new();
     b.format(x).to_string()
@@ -305,9 +346,10 @@ impl RunMeta {
 pub struct EndMeta {
     /// Steps taken.
     pub steps: u64,
-    /// `completed`, `stopped` (by the scene), `interrupted` (Ctrl-C), `error`, or `aborted`.
+    /// `completed`, `stopped` (by the scene), `interrupted` (by a signal), `error` (in a step),
+    /// `setup_failed` ([`SETUP_FAILED`]: the scene could not be built), or `aborted`.
     pub outcome: String,
-    /// The scene's reason, or the error.
+    /// The scene's reason, the error, or the signal that interrupted the run (`SIGTERM`).
     pub reason: String,
     /// The final state hash.
     pub hash: u64,

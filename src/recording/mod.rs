@@ -34,6 +34,6 @@ pub mod verify;
 pub mod writer;
 
 pub use error::RecordingError;
-pub use meta::{EndMeta, RunMeta, RunOverrides, SceneSource};
+pub use meta::{EndMeta, RunMeta, RunOverrides, SceneSource, SETUP_FAILED};
 pub use reader::Recording;
-pub use writer::{Recorder, Written};
+pub use writer::{write_failed_setup, Recorder, Written};

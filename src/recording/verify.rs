@@ -71,6 +71,19 @@ pub fn verify(
             return Ok(Flow::Continue);
         }
         let step = decode::<StepOnly>(topic, data)?.step;
+        // A step past every hash read (the error comes one after) is damage, not steps to run.
+        if step > rec.last_step().saturating_add(1) && report.mismatch.is_none() {
+            report.mismatch = Some(Mismatch {
+                step: replay.step_count(),
+                what: format!(
+                    "a {topic} message names step {step}, past the last step recorded ({}):                      the file is damaged",
+                    rec.last_step()
+                ),
+                critter: None,
+            });
+            done = true;
+            return Ok(Flow::Stop);
+        }
         // After a mismatch, only look for the next full state, to name the critter.
         let looking = report.mismatch.is_some();
         if looking && topic != schema::STATE {

@@ -10,7 +10,7 @@
 use super::capture::{self, KindTable, StepRecord};
 use super::error::RecordingError;
 use super::foxglove;
-use super::meta::{EndMeta, RunMeta};
+use super::meta::{EndMeta, RunMeta, SETUP_FAILED};
 use super::schema::{self, ErrorMsg, Float, HashMsg, StateMsg};
 use crate::scenes::{AnyWorld, SourceFile};
 use mcap::records::{MessageHeader, Metadata};
@@ -106,39 +106,7 @@ impl Recorder {
         sources: &[SourceFile],
         world: &AnyWorld,
     ) -> Result<Recorder, RecordingError> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| write_err(path, e))?;
-        }
-        let file = File::create(path).map_err(|e| write_err(path, e))?;
-        let options = WriteOptions::new()
-            .compression(Some(mcap::Compression::Zstd))
-            .compression_level(ZSTD_LEVEL)
-            .compression_threads(0)
-            .profile("critterbox")
-            .library(format!("critterbox {}", env!("CARGO_PKG_VERSION")));
-        let mut w = options
-            .create(BufWriter::with_capacity(1 << 20, file))
-            .map_err(|e| write_err(path, e))?;
-        let mut channels = BTreeMap::new();
-        for c in schema::channel_schemas() {
-            let text = serde_json::to_vec(&c.schema).map_err(|e| write_err(path, e))?;
-            let schema_id = w
-                .add_schema(c.name, "jsonschema", &text)
-                .map_err(|e| write_err(path, e))?;
-            let id = w
-                .add_channel(schema_id, c.topic, "json", &BTreeMap::new())
-                .map_err(|e| write_err(path, e))?;
-            channels.insert(c.topic, id);
-        }
-        w.write_metadata(&Metadata {
-            name: schema::META.into(),
-            metadata: meta.to_map(),
-        })
-        .map_err(|e| write_err(path, e))?;
-        for s in sources {
-            attach(&mut w, s).map_err(|e| write_err(path, e))?;
-        }
-        w.flush().map_err(|e| write_err(path, e))?;
+        let (w, channels) = open(path, meta, sources)?;
 
         let (tx, rx) = mpsc::sync_channel::<Job>(QUEUE);
         let thread_path = path.to_path_buf();
@@ -317,6 +285,97 @@ impl Drop for Recorder {
     }
 }
 
+/// The MCAP writer of a recording's file.
+type McapFile = mcap::Writer<BufWriter<File>>;
+
+/// Channel ids by topic.
+type Channels = BTreeMap<&'static str, u16>;
+
+/// Creates the file and writes the metadata, the schemas and channels, and the script
+/// attachments, flushed so that they survive a kill.
+fn open(
+    path: &Path,
+    meta: &RunMeta,
+    sources: &[SourceFile],
+) -> Result<(McapFile, Channels), RecordingError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| write_err(path, e))?;
+    }
+    let file = File::create(path).map_err(|e| write_err(path, e))?;
+    let options = WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .compression_level(ZSTD_LEVEL)
+        .compression_threads(0)
+        .profile("critterbox")
+        .library(format!("critterbox {}", env!("CARGO_PKG_VERSION")));
+    let mut w = options
+        .create(BufWriter::with_capacity(1 << 20, file))
+        .map_err(|e| write_err(path, e))?;
+    let mut channels = BTreeMap::new();
+    for c in schema::channel_schemas() {
+        let text = serde_json::to_vec(&c.schema).map_err(|e| write_err(path, e))?;
+        let schema_id = w
+            .add_schema(c.name, "jsonschema", &text)
+            .map_err(|e| write_err(path, e))?;
+        let id = w
+            .add_channel(schema_id, c.topic, "json", &BTreeMap::new())
+            .map_err(|e| write_err(path, e))?;
+        channels.insert(c.topic, id);
+    }
+    w.write_metadata(&Metadata {
+        name: schema::META.into(),
+        metadata: meta.to_map(),
+    })
+    .map_err(|e| write_err(path, e))?;
+    for s in sources {
+        attach(&mut w, s).map_err(|e| write_err(path, e))?;
+    }
+    w.flush().map_err(|e| write_err(path, e))?;
+    Ok((w, channels))
+}
+
+/// Records a run whose scene could not be built: the metadata, the script files read up to the
+/// failure, the error (at step 0) and an end record with outcome [`SETUP_FAILED`] and the
+/// error as its reason. The file holds no step, so nothing in it can be replayed or verified.
+pub fn write_failed_setup(
+    path: &Path,
+    meta: &RunMeta,
+    sources: &[SourceFile],
+    message: &str,
+) -> Result<Written, RecordingError> {
+    let (w, channels) = open(path, meta, sources)?;
+    let mut out = Output {
+        w,
+        channels,
+        sequence: BTreeMap::new(),
+        colors: Vec::new(),
+        last_log_time: 0,
+        steps: 0,
+        states: 0,
+    };
+    let error = ErrorMsg {
+        step: 0,
+        time: Float(0.0),
+        message: message.to_string(),
+    };
+    out.put_json(schema::ERROR, 0, &error)
+        .map_err(|e| write_err(path, e))?;
+    let end = EndMeta {
+        steps: 0,
+        outcome: SETUP_FAILED.into(),
+        reason: message.to_string(),
+        hash: 0,
+        profile: Vec::new(),
+    };
+    out.close(&end).map_err(|e| write_err(path, e))?;
+    Ok(Written {
+        path: path.to_path_buf(),
+        bytes: std::fs::metadata(path).map_or(0, |m| m.len()),
+        steps: 0,
+        states: 0,
+    })
+}
+
 fn attach<W: std::io::Write + std::io::Seek>(
     w: &mut mcap::Writer<W>,
     s: &SourceFile,
@@ -332,8 +391,8 @@ fn attach<W: std::io::Write + std::io::Seek>(
 
 /// The writer thread's side.
 struct Output {
-    w: mcap::Writer<BufWriter<File>>,
-    channels: BTreeMap<&'static str, u16>,
+    w: McapFile,
+    channels: Channels,
     sequence: BTreeMap<u16, u32>,
     colors: Vec<foxglove::Rgba>,
     last_log_time: u64,

@@ -233,6 +233,16 @@ pub fn load_scene(
     scene::load(path, sets, options)
 }
 
+/// As [`load_scene`], but a failure also gives the script files read up to it (the scene first,
+/// then its kinds, the failing one included), so `critterbox run` can record a failed set-up.
+pub fn load_scene_keeping_sources(
+    path: &Path,
+    sets: &[(String, String)],
+    options: &ScriptOptions,
+) -> Result<Scene, (Error, Vec<SourceFile>)> {
+    scene::load_keeping_sources(path, sets, options)
+}
+
 /// A world that script kinds can be loaded into: `World<DVec2>` and `World<DVec3>`.
 pub trait ScriptWorld {
     /// Loads the kind file at `path` (and the kinds it extends, from the same folder) into the

@@ -78,17 +78,51 @@ pub(crate) fn load(
     sets: &[(String, String)],
     options: &ScriptOptions,
 ) -> Result<Scene, Error> {
+    load_keeping_sources(path, sets, options).map_err(|(e, _)| e)
+}
+
+/// As [`load`], but a failure also gives the script files read before it (the scene first, as
+/// far as it was read), so a failed set-up can still be recorded with them.
+pub(crate) fn load_keeping_sources(
+    path: &Path,
+    sets: &[(String, String)],
+    options: &ScriptOptions,
+) -> Result<Scene, (Error, Vec<SourceFile>)> {
     let file = path.display().to_string();
-    let text = apply_sets(&file, &read_script(path)?, sets)?;
-    let rt = Runtime::new(options, path.parent());
-    let ast = rt.compile(&file, &text)?;
-    rt.sources.borrow_mut().insert(
-        0,
-        SourceFile {
+    let raw = read_script(path).map_err(|e| (e, Vec::new()))?;
+    let text = apply_sets(&file, &raw, sets).map_err(|e| {
+        let scene = SourceFile {
             path: file.clone(),
-            text: text.clone(),
-        },
-    );
+            text: raw.clone(),
+        };
+        (e, vec![scene])
+    })?;
+    let rt = Runtime::new(options, path.parent());
+    rt.sources.borrow_mut().push(SourceFile {
+        path: file.clone(),
+        text: text.clone(),
+    });
+    set_up(&rt, path, &file, &text).map_err(|e| {
+        let mut read = rt.sources.borrow().clone();
+        // A kind file that failed to compile or load is kept only once it loads: add its text.
+        if let Error::Script(s) = &e {
+            if !read.iter().any(|f| f.path == s.file) {
+                if let Ok(text) = std::fs::read_to_string(&s.file) {
+                    read.push(SourceFile {
+                        path: s.file.clone(),
+                        text,
+                    });
+                }
+            }
+        }
+        (e, read)
+    })
+}
+
+/// Compiles the scene's text and runs its top level, which builds the world.
+fn set_up(rt: &Rc<Runtime>, path: &Path, file: &str, text: &str) -> Result<Scene, Error> {
+    let (file, text) = (file.to_string(), text.to_string());
+    let ast = rt.compile(&file, &text)?;
 
     let mut scope = Scope::new();
     let ran = rt.engine.run_ast_with_scope(&mut scope, &ast);

@@ -258,6 +258,10 @@ pub fn summary_head(rec: &Recording, out: &mut dyn Write) -> anyhow::Result<()> 
         writeln!(out, "command      {}", m.command_line.join(" "))?;
     }
     let ended = match (&rec.end, &rec.error) {
+        (Some(e), _) if e.outcome == critterbox::recording::SETUP_FAILED => {
+            format!("failed during set-up: {}", e.reason)
+        }
+        (Some(e), _) if e.outcome == "interrupted" => format!("interrupted ({})", e.reason),
         (_, Some(e)) => format!("ended by an error in step {}: {}", e.step, e.message),
         (Some(e), _) if e.outcome == "stopped" => format!("stopped by the scene: {}", e.reason),
         (Some(e), _) => e.outcome.clone(),

@@ -3,7 +3,7 @@
 use super::record::{self, RecordArgs};
 use anyhow::Context;
 use clap::Args;
-use critterbox::scenes::{self, AnyWorld, Scene, SceneParams, DEFAULT_SCENE, SCENES};
+use critterbox::scenes::{self, AnyWorld, Scene, SceneParams, SourceFile, DEFAULT_SCENE, SCENES};
 use critterbox::script::{Limits, ScriptOptions};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::Write;
@@ -11,6 +11,12 @@ use std::time::{Duration, Instant};
 
 /// Arguments of `critterbox run`.
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Exit codes: 0 when the run completed or the scene stopped it; 1 on an \
+error (a scene that cannot be built is still recorded, with its scripts and the error); \
+128 + the signal when SIGINT (130), SIGTERM (143) or SIGHUP (129) stopped it after the current \
+step, with the recording finished (end record `interrupted`, naming the signal)."
+)]
 pub struct RunArgs {
     /// A scene script (scripts/scenes/NAME.rhai) or a built-in scene (see --list). Default: gas.
     pub scene: Option<String>,
@@ -85,12 +91,26 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             "--dt {dt}: the time step must be a finite number greater than zero"
         );
     }
-    let mut scene = load(args)?;
-    if let Some(dt) = args.dt {
-        scene.world.set_dt(dt)?;
-    }
-    if let Some(m) = args.method {
-        scene.world.set_method(m)?;
+    let mut scene = match load(args) {
+        Ok(scene) => scene,
+        Err(Unloaded::Usage(e)) => return Err(e),
+        Err(Unloaded::Setup {
+            error,
+            name,
+            file,
+            sources,
+        }) => return failed_setup(args, &name, file.as_deref(), &sources, error, out),
+    };
+    if let Err(error) = configure(&mut scene, args) {
+        let file = scene.sources.first().map(|s| s.path.clone());
+        return failed_setup(
+            args,
+            &scene.name,
+            file.as_deref(),
+            &scene.sources,
+            error,
+            out,
+        );
     }
     let name = scene.name.clone();
     let steps = args.steps.unwrap_or(scene.default_steps);
@@ -99,17 +119,19 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let momentum0 = scene.world.momentum();
     let mut viewer = super::view::Viewer::open(&args.view, &scene.world)?;
     // Recording: started before the first step, fed after each one, closed at the end.
+    // Watched from the file's creation on (a signal during the set-up ends the process as
+    // usual: there is no run to finish yet), so a file that exists is finished by a signal.
+    record::watch_signals();
     let mut recorder = record::start(args, &scene, steps)?;
-    record::watch_ctrl_c();
-    let mut interrupted = false;
+    let mut interrupted = None;
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
     // Time the simulation thread spends recording (hash, totals, events, handing them over).
     let mut recording = Duration::ZERO;
     for i in 0..steps {
-        if record::interrupted() {
-            interrupted = true;
+        if let Some(sig) = record::interrupted() {
+            interrupted = Some(sig);
             break;
         }
         let step = scene.world.step_count();
@@ -195,6 +217,10 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if let Some((at, reason)) = &stopped {
         writeln!(out, "stopped      by the scene after step {at}: {reason}")?;
     }
+    if let Some(sig) = interrupted {
+        let name = record::signal_name(sig);
+        writeln!(out, "ended        interrupted ({name}) after step {done}")?;
+    }
     if args.stats {
         stats(
             out,
@@ -209,43 +235,105 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         }
     }
     let (outcome, reason) = match (&stopped, interrupted) {
-        (_, true) => ("interrupted", "Ctrl-C".to_string()),
+        (_, Some(sig)) => ("interrupted", record::signal_name(sig)),
         (Some((_, reason)), _) => ("stopped", reason.clone()),
         _ => ("completed", String::new()),
     };
+    let recorded = recorder.is_some();
     record::finish(recorder, &scene, outcome, &reason, out)?;
-    anyhow::ensure!(
-        !interrupted,
-        "interrupted by Ctrl-C after step {done} (the recording is complete up to there)"
-    );
+    if let Some(signal) = interrupted {
+        return Err(record::Interrupted {
+            signal,
+            step: done,
+            recorded,
+        }
+        .into());
+    }
     Ok(())
 }
 
+/// Why no scene came out of [`load`].
+enum Unloaded {
+    /// The command line asks for something impossible: nothing ran, nothing is recorded.
+    Usage(anyhow::Error),
+    /// Building the scene failed: the run is recorded with the error.
+    Setup {
+        error: anyhow::Error,
+        /// The scene's name (a built-in's, or the script's file stem).
+        name: String,
+        /// The scene script, for a script scene.
+        file: Option<String>,
+        /// The scripts read up to the error.
+        sources: Vec<SourceFile>,
+    },
+}
+
+/// The command line's `--dt` and `--method`, applied to the built scene.
+fn configure(scene: &mut Scene, args: &RunArgs) -> anyhow::Result<()> {
+    if let Some(dt) = args.dt {
+        scene.world.set_dt(dt)?;
+    }
+    if let Some(m) = args.method {
+        scene.world.set_method(m)?;
+    }
+    Ok(())
+}
+
+/// Records a run whose scene could not be built, then gives its error back to be reported (a
+/// recording that cannot be written is a warning: the set-up error is the one to report).
+fn failed_setup(
+    args: &RunArgs,
+    name: &str,
+    file: Option<&str>,
+    sources: &[SourceFile],
+    error: anyhow::Error,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    if let Err(e) = record::failed_setup(args, name, file, sources, &error, out) {
+        eprintln!("warning: the failed set-up could not be recorded: {e:#}");
+    }
+    Err(error)
+}
+
 /// A scene script when SCENE names a file, a built-in scene otherwise.
-fn load(args: &RunArgs) -> anyhow::Result<Scene> {
+fn load(args: &RunArgs) -> Result<Scene, Unloaded> {
     let name = args.scene.as_deref().unwrap_or(DEFAULT_SCENE);
-    let is_script = name.ends_with(".rhai") || std::path::Path::new(name).is_file();
+    let path = std::path::Path::new(name);
+    let is_script = name.ends_with(".rhai") || path.is_file();
+    let usage = |e: anyhow::Error| Unloaded::Usage(e);
     if !is_script {
-        anyhow::ensure!(
-            args.sets.is_empty(),
-            "--set works on scene scripts; '{name}' is a built-in scene (try -n, --dt, --seed)"
-        );
+        if !args.sets.is_empty() {
+            return Err(usage(anyhow::anyhow!(
+                "--set works on scene scripts; '{name}' is a built-in scene (try -n, --dt, --seed)"
+            )));
+        }
         let params = SceneParams {
             n: args.n,
             seed: args.seed.unwrap_or(1),
             dt: args.dt,
         };
-        return Ok(scenes::builtin(name, &params)?);
+        return scenes::builtin(name, &params).map_err(|e| match e {
+            // A name that is no scene is a mistyped command, not a failed set-up.
+            critterbox::Error::UnknownScene { .. } => usage(e.into()),
+            e => Unloaded::Setup {
+                error: e.into(),
+                name: name.to_string(),
+                file: None,
+                sources: Vec::new(),
+            },
+        });
     }
-    anyhow::ensure!(
-        args.n.is_none(),
-        "-n works on built-in scenes; a scene script sets its own counts (use --set NAME=VALUE)"
-    );
+    if args.n.is_some() {
+        return Err(usage(anyhow::anyhow!(
+            "-n works on built-in scenes; a scene script sets its own counts (use --set NAME=VALUE)"
+        )));
+    }
     let mut sets = Vec::new();
     for s in &args.sets {
         let (k, v) = s
             .split_once('=')
-            .with_context(|| format!("--set {s}: write NAME=VALUE, e.g. --set SPEED=20"))?;
+            .with_context(|| format!("--set {s}: write NAME=VALUE, e.g. --set SPEED=20"))
+            .map_err(usage)?;
         sets.push((k.trim().to_string(), v.trim().to_string()));
     }
     let options = ScriptOptions {
@@ -254,11 +342,22 @@ fn load(args: &RunArgs) -> anyhow::Result<Scene> {
         profile: profiled(args),
         ..ScriptOptions::default()
     };
-    Ok(critterbox::script::load_scene(
-        std::path::Path::new(name),
-        &sets,
-        &options,
-    )?)
+    critterbox::script::load_scene_keeping_sources(path, &sets, &options).map_err(
+        |(error, sources)| {
+            // A script that could not be read at all is a mistyped path: nothing to record.
+            if sources.is_empty() {
+                return usage(error.into());
+            }
+            Unloaded::Setup {
+                error: error.into(),
+                name: path
+                    .file_stem()
+                    .map_or(name.to_string(), |s| s.to_string_lossy().into_owned()),
+                file: Some(name.to_string()),
+                sources,
+            }
+        },
+    )
 }
 
 /// Whether the run times its hooks (critterbox::profile): with `--stats`, whose table it feeds,
