@@ -3,6 +3,7 @@
 use crate::error::Error;
 use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
+use crate::world::fmt_vec;
 use glam::{DMat3, DVec2, DVec3};
 
 /// Pop's default wall thickness.
@@ -57,7 +58,7 @@ impl<V: Vector> WallBox<V> {
         if !self.center.all_finite() {
             return Err(bad(
                 "center",
-                format!("{:?}", self.center),
+                fmt_vec(self.center),
                 "must be finite",
             ));
         }
@@ -66,7 +67,7 @@ impl<V: Vector> WallBox<V> {
             if !(h.is_finite() && h > 0.0) {
                 return Err(bad(
                     "size",
-                    format!("{:?}", self.half * 2.0),
+                    fmt_vec(self.half * 2.0),
                     "every side (length, thickness) must be finite and greater than zero",
                 ));
             }
@@ -164,7 +165,7 @@ impl WallBox<DVec2> {
         if !(a.is_finite() && b.is_finite()) {
             return Err(Error::InvalidWall {
                 field: "ends",
-                value: format!("{a:?} to {b:?}"),
+                value: format!("{} to {}", fmt_vec(a), fmt_vec(b)),
                 reason: "must be finite".into(),
             });
         }
@@ -172,7 +173,7 @@ impl WallBox<DVec2> {
         if !has_length {
             return Err(Error::InvalidWall {
                 field: "ends",
-                value: format!("{a:?} to {b:?}"),
+                value: format!("{} to {}", fmt_vec(a), fmt_vec(b)),
                 reason: "the two ends must differ (a wall needs a length)".into(),
             });
         }
