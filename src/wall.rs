@@ -56,11 +56,7 @@ impl<V: Vector> WallBox<V> {
             reason: reason.to_string(),
         };
         if !self.center.all_finite() {
-            return Err(bad(
-                "center",
-                fmt_vec(self.center),
-                "must be finite",
-            ));
+            return Err(bad("center", fmt_vec(self.center), "must be finite"));
         }
         for axis in 0..V::DIM {
             let h = self.half.get(axis);

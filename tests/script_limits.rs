@@ -73,15 +73,30 @@ fn hostile(name: &str, body: &str, options: &ScriptOptions, flags: &[&str]) -> S
     let scene = scene_of(&sandbox, name, 1);
     let first = fail(&scene, options, name, 3);
     let again = fail(&scene, options, name, 3);
-    assert_eq!(first, again, "two runs stop at the same step for the same reason");
+    assert_eq!(
+        first, again,
+        "two runs stop at the same step for the same reason"
+    );
     let e = &first.err;
     let file = std::fs::canonicalize(&e.file).expect("the error names an existing file");
-    assert_eq!(file, std::fs::canonicalize(&kind).expect("the kind file"), "{e}");
-    assert_eq!((e.line, e.column), (Some(1), Some(1)), "the hook's line:\n{e}");
+    assert_eq!(
+        file,
+        std::fs::canonicalize(&kind).expect("the kind file"),
+        "{e}"
+    );
+    assert_eq!(
+        (e.line, e.column),
+        (Some(1), Some(1)),
+        "the hook's line:\n{e}"
+    );
     assert_eq!(e.kind.as_deref(), Some(name), "{e}");
     assert_eq!(e.hook.as_deref(), Some("update"), "{e}");
     assert_eq!(e.critter, Some(first.critters[0]), "{e}");
-    assert_eq!((e.step, first.steps_ok), (Some(0), 0), "the first call fails:\n{e}");
+    assert_eq!(
+        (e.step, first.steps_ok),
+        (Some(0), 0),
+        "the first call fails:\n{e}"
+    );
     assert!(
         flags.iter().any(|flag| e.to_string().contains(flag)),
         "the error names one of {flags:?}:\n{e}"
@@ -160,11 +175,18 @@ fn items_of_nested_arrays_count_toward_the_array_limit() {
     // Each pushed [1, 2, 3, 4] is 5 items (itself and its 4): 20 pushes are 100 items, 21 are 105.
     let options = limits(|l| l.max_array_size = 100);
     let sandbox = Sandbox::new("nested_count");
-    let push = |n: u32| format!("fn update(me, dt) {{\n    let a = [];\n    for i in 0..{n} {{ a.push([1, 2, 3, 4]); }}\n}}\n");
+    let push = |n: u32| {
+        format!("fn update(me, dt) {{\n    let a = [];\n    for i in 0..{n} {{ a.push([1, 2, 3, 4]); }}\n}}\n")
+    };
     sandbox.kind("fits", &push(20));
     sandbox.kind("overflows", &push(21));
     runs(&scene_of(&sandbox, "fits", 1), &options, 2);
-    let f = fail(&scene_of(&sandbox, "overflows", 1), &options, "overflows", 2);
+    let f = fail(
+        &scene_of(&sandbox, "overflows", 1),
+        &options,
+        "overflows",
+        2,
+    );
     assert!(f.err.to_string().contains("--max-array"), "{}", f.err);
 }
 
@@ -182,7 +204,10 @@ fn hooks_each_inside_max_ops_stop_at_the_step_budget_on_the_same_critter_each_ru
     let options = limits(|l| l.max_step_operations = 300_000);
     let first = fail(&scene, &options, "busy", 3);
     let again = fail(&scene, &options, "busy", 3);
-    assert_eq!(first, again, "two runs stop at the same critter, step and message");
+    assert_eq!(
+        first, again,
+        "two runs stop at the same critter, step and message"
+    );
     let e = &first.err;
     assert_eq!((e.step, first.steps_ok), (Some(0), 0), "{e}");
     assert_eq!(e.hook.as_deref(), Some("update"), "{e}");
@@ -193,7 +218,10 @@ fn hooks_each_inside_max_ops_stop_at_the_step_budget_on_the_same_critter_each_ru
         .unwrap_or_else(|| panic!("the error names one of the critters:\n{e}"));
     // The calls before it fit: the budget is shared, not per call.
     assert!(at > 0, "the first call alone fits the budget:\n{e}");
-    assert!(e.message.contains("300000") && e.message.contains("step 0"), "{e}");
+    assert!(
+        e.message.contains("300000") && e.message.contains("step 0"),
+        "{e}"
+    );
     assert!(e.to_string().contains("--max-step-ops"), "{e}");
     // Without the budget, the same scene runs.
     runs(&scene, &limits(|l| l.max_step_operations = 0), 2);
@@ -245,10 +273,21 @@ fn the_default_limits_run_every_shipped_scene() {
 #[test]
 fn a_non_finite_velocity_is_shown_as_users_write_vectors() {
     let sandbox = Sandbox::new("nan_vel");
-    sandbox.kind("nan", "fn update(me, dt) {\n    me.vel = vec(5, sqrt(-1.0));\n}\n");
-    let f = fail(&scene_of(&sandbox, "nan", 1), &ScriptOptions::default(), "nan", 2);
+    sandbox.kind(
+        "nan",
+        "fn update(me, dt) {\n    me.vel = vec(5, sqrt(-1.0));\n}\n",
+    );
+    let f = fail(
+        &scene_of(&sandbox, "nan", 1),
+        &ScriptOptions::default(),
+        "nan",
+        2,
+    );
     let shown = f.err.to_string();
-    assert!(shown.contains("(5, NaN)"), "x then y, two components in 2D:\n{shown}");
+    assert!(
+        shown.contains("(5, NaN)"),
+        "x then y, two components in 2D:\n{shown}"
+    );
     assert!(!shown.contains("DVec") && !shown.contains('['), "{shown}");
 }
 

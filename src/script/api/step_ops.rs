@@ -23,24 +23,33 @@ struct StepOps {
 
 impl StepOps {
     /// Counts operation `ops` of the running call; the error's text once the step is over budget.
-    /// rhai counts each call from 1, so a count that does not grow starts a new call. A call
-    /// nested in another (a spawn's `init`) is counted with its caller's count so far, a little
-    /// more than it ran, but the same on every run.
+    /// rhai counts each call from 1 and calls this at every operation, so a count of 1 starts a
+    /// call, and any other jump resumes a caller after a call nested in it (a spawn's `init`):
+    /// the step's total is then `spent + ops` exactly.
     fn count(&self, ops: u64, step_now: impl FnOnce() -> Option<u64>) -> Option<String> {
         let last = self.last.replace(ops);
-        if ops <= last {
+        if ops == 1 {
             let step = step_now();
             if step.is_some() && step != self.step.get() {
                 self.step.set(step);
                 self.spent.set(0);
             } else {
+                // The previous call's operations, or the caller's so far when this one nests.
                 self.spent.set(self.spent.get().saturating_add(last));
             }
+        } else if ops != last.wrapping_add(1) {
+            // A caller resumes: add the nested call's operations, less the caller's own, which
+            // were added when the nested call began and which `ops` counts again.
+            let spent = self.spent.get().saturating_add(last);
+            self.spent.set(spent.saturating_sub(ops - 1));
         }
         if self.spent.get().saturating_add(ops) <= self.max {
             return None;
         }
-        let step = self.step.get().map_or(String::new(), |s| format!(" in step {s}"));
+        let step = self
+            .step
+            .get()
+            .map_or(String::new(), |s| format!(" in step {s}"));
         Some(format!(
             "the scripts ran more than {} operations{step} together (all hook calls of the step)\
              {HINT_MARK}do the hooks do more work than they need, for every critter? If the work \
@@ -63,8 +72,7 @@ pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64) {
     };
     let h = host.clone();
     engine.on_progress(move |n| {
-        let step_now =
-            || with_env!(h, env => Ok::<_, Box<EvalAltResult>>(env.step_count())).ok();
+        let step_now = || with_env!(h, env => Ok::<_, Box<EvalAltResult>>(env.step_count())).ok();
         ops.count(n, step_now).map(Dynamic::from)
     });
 }
@@ -102,6 +110,25 @@ mod tests {
     }
 
     #[test]
+    fn a_nested_call_counts_once_with_its_caller() {
+        let b = budget(1000);
+        let step = || Some(0);
+        // The caller runs 300, a nested call 200, the caller 100 more: 600 in all.
+        for n in 1..=300 {
+            assert!(b.count(n, step).is_none());
+        }
+        for n in 1..=200 {
+            assert!(b.count(n, step).is_none());
+        }
+        for n in 301..=400 {
+            assert!(b.count(n, step).is_none());
+        }
+        assert_eq!(b.spent.get() + b.last.get(), 600);
+        // So 400 more fit, and the 401st does not.
+        assert_eq!(run(&b, 0, &[400, 1]), Some((1, 1)));
+    }
+
+    #[test]
     fn a_new_step_starts_a_new_budget() {
         let b = budget(1000);
         assert_eq!(run(&b, 0, &[400, 400]), None);
@@ -112,8 +139,13 @@ mod tests {
     #[test]
     fn the_error_names_the_step_the_budget_and_the_flag() {
         let b = budget(10);
-        let text = (1..=11).find_map(|n| b.count(n, || Some(7))).expect("over budget");
-        assert!(text.contains("step 7") && text.contains("10 operations"), "{text}");
+        let text = (1..=11)
+            .find_map(|n| b.count(n, || Some(7)))
+            .expect("over budget");
+        assert!(
+            text.contains("step 7") && text.contains("10 operations"),
+            "{text}"
+        );
         assert!(text.contains("--max-step-ops"), "{text}");
     }
 }

@@ -63,7 +63,10 @@ pub(crate) fn show(d: &Dynamic) -> String {
         return format!("[{}]", items.join(", "));
     }
     if let Some(m) = d.read_lock::<Map>() {
-        let items: Vec<String> = m.iter().map(|(k, v)| format!("{:?}: {}", k.as_str(), show(v))).collect();
+        let items: Vec<String> = m
+            .iter()
+            .map(|(k, v)| format!("{:?}: {}", k.as_str(), show(v)))
+            .collect();
         return format!("#{{{}}}", items.join(", "));
     }
     if d.is_string() {
