@@ -330,6 +330,7 @@ fn vectors_print_with_the_worlds_components() {
             ))
             .err()
             .expect("the scene throws");
-        assert!(e.to_string().contains(want), "{dim}D: want {want}:\n{e}");
+        let e = script_error(e);
+        assert_eq!(e.message, want, "{dim}D:\n{e}");
     }
 }
