@@ -3,6 +3,7 @@
 use crate::error::Error;
 use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
+use crate::world::fmt_vec;
 use glam::{DMat3, DVec2, DVec3};
 
 /// Pop's default wall thickness.
@@ -55,18 +56,14 @@ impl<V: Vector> WallBox<V> {
             reason: reason.to_string(),
         };
         if !self.center.all_finite() {
-            return Err(bad(
-                "center",
-                format!("{:?}", self.center),
-                "must be finite",
-            ));
+            return Err(bad("center", fmt_vec(self.center), "must be finite"));
         }
         for axis in 0..V::DIM {
             let h = self.half.get(axis);
             if !(h.is_finite() && h > 0.0) {
                 return Err(bad(
                     "size",
-                    format!("{:?}", self.half * 2.0),
+                    fmt_vec(self.half * 2.0),
                     "every side (length, thickness) must be finite and greater than zero",
                 ));
             }
@@ -164,7 +161,7 @@ impl WallBox<DVec2> {
         if !(a.is_finite() && b.is_finite()) {
             return Err(Error::InvalidWall {
                 field: "ends",
-                value: format!("{a:?} to {b:?}"),
+                value: format!("{} to {}", fmt_vec(a), fmt_vec(b)),
                 reason: "must be finite".into(),
             });
         }
@@ -172,7 +169,7 @@ impl WallBox<DVec2> {
         if !has_length {
             return Err(Error::InvalidWall {
                 field: "ends",
-                value: format!("{a:?} to {b:?}"),
+                value: format!("{} to {}", fmt_vec(a), fmt_vec(b)),
                 reason: "the two ends must differ (a wall needs a length)".into(),
             });
         }

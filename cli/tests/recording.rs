@@ -437,6 +437,42 @@ fn a_script_error_is_written_into_the_recording_before_it_is_reported() {
 }
 
 #[test]
+fn a_run_stopped_by_the_step_budget_records_it_and_its_replay_stops_at_the_same_step() {
+    let dir = tmp("step_budget");
+    let scene = dir.join("busy.rhai");
+    // on_step's work grows with the step count, so the budget stops it at a later step.
+    std::fs::write(
+        &scene,
+        "let w = world(#{ dim: 2, size: vec(10, 10), seed: 3 });\n\
+         spawn(\"ball\", #{ pos: vec(5, 5), vel: vec(1, 0) });\n\
+         fn on_step(world) {\n    let i = 0;\n    while i < world.step_count * 2000 { i += 1; }\n}\n",
+    )
+    .expect("write scene");
+    let file = dir.join("busy.mcap");
+    let run = critterbox(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--steps",
+        "50",
+        "--max-step-ops",
+        "100000",
+        "--record",
+        file.to_str().unwrap(),
+    ]);
+    assert!(!run.status.success(), "{}", text(&run));
+    assert!(text(&run).contains("--max-step-ops"), "{}", text(&run));
+    let r = Recording::open(&file).expect("the file is complete");
+    assert_eq!(r.meta().limits.max_step_operations, 100_000);
+    let e = r.error.as_ref().expect("an error message");
+    assert!(e.message.contains("100000 operations"), "{}", e.message);
+    let stopped = r.end.as_ref().map(|e| e.steps);
+    assert!(stopped.is_some_and(|s| s > 1), "a later step: {stopped:?}");
+    let o = critterbox(&["replay", file.to_str().unwrap(), "--verify"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("reproduced"), "{}", text(&o));
+}
+
+#[test]
 fn bad_files_are_clear_errors_never_panics() {
     let dir = tmp("bad_files");
     let good = dir.join("good.mcap");

@@ -175,6 +175,7 @@ fn float(x: f64) -> String {
 fn limits_json(l: &Limits) -> String {
     json!({
         "max_operations": l.max_operations,
+        "max_step_operations": l.max_step_operations,
         "max_call_levels": l.max_call_levels,
         "max_string_size": l.max_string_size,
         "max_array_size": l.max_array_size,
@@ -301,6 +302,8 @@ impl RunMeta {
         let lim = |k: &str, default: u64| limits.get(k).and_then(|v| v.as_u64()).unwrap_or(default);
         let limits = Limits {
             max_operations: lim("max_operations", d.max_operations),
+            // A recording from before the step budget ran without one.
+            max_step_operations: lim("max_step_operations", 0),
             max_call_levels: lim("max_call_levels", d.max_call_levels as u64) as usize,
             max_string_size: lim("max_string_size", d.max_string_size as u64) as usize,
             max_array_size: lim("max_array_size", d.max_array_size as u64) as usize,

@@ -90,10 +90,38 @@ pub(crate) fn eval_error(
             "no property '{name}'; critters have pos, vel, radius, mass, health, restitution, priority, fixed, alive, id, kind and user properties"
         )),
         EvalAltResult::ErrorStackOverflow(_) => Some("a function calls itself without end, or calls nest too deep".into()),
-        EvalAltResult::ErrorDataTooLarge(..) => Some("a string, array or map grew past the sandbox limit".into()),
+        EvalAltResult::ErrorDataTooLarge(what, _) => {
+            let (data, flag) = too_large(what);
+            err.message = format!("{data} grew past the sandbox's limit (--{flag})");
+            Some(format!(
+                "does a loop add to it without end? If the data is real, raise the limit with --{flag}"
+            ))
+        }
+        EvalAltResult::ErrorTerminated(token, _) => {
+            // The step's operations budget (api::step_ops) stops a script with its text.
+            let text = token.to_string();
+            match text.split_once(super::api::HINT_MARK) {
+                Some((m, h)) => {
+                    err.message = m.to_string();
+                    Some(h.to_string())
+                }
+                None => carried_hint,
+            }
+        }
         _ => carried_hint,
     };
     err
+}
+
+/// What grew too large, in words, and the flag that limits it, from rhai's name of the data.
+fn too_large(what: &str) -> (&'static str, &'static str) {
+    if what.contains("string") {
+        ("a string", "max-string")
+    } else if what.contains("map") {
+        ("a map (with the maps inside it)", "max-map")
+    } else {
+        ("an array (with the arrays inside it)", "max-array")
+    }
 }
 
 /// Finds `fn name(` at the start of a line: the 1-based line and column of the definition.

@@ -32,18 +32,24 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-/// Limits on what one script call may do. The defaults are far above what real scripts need.
+/// Limits on what script calls may do: all are counts, never times, so a run stops at the same
+/// place on every machine. The defaults are far above what real scripts need, and low enough
+/// that a hostile script stops within a bounded amount of work (see "Sandbox and limits" in
+/// `docs/scripting.md`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Limits {
     /// Operations per hook call (an endless loop stops here).
     pub max_operations: u64,
+    /// Operations of all script calls of one step together; 0 for no such budget.
+    pub max_step_operations: u64,
     /// Depth of nested function calls.
     pub max_call_levels: usize,
     /// Longest string.
     pub max_string_size: usize,
-    /// Longest array.
+    /// Longest array (items of nested arrays count too). rhai measures an array after each
+    /// operation that may change it, so this also bounds the work of one operation.
     pub max_array_size: usize,
-    /// Largest map.
+    /// Largest map (entries of nested maps count too).
     pub max_map_size: usize,
     /// Spawns scripts may request in one step.
     pub max_spawns_per_step: u64,
@@ -53,10 +59,11 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             max_operations: 1_000_000,
+            max_step_operations: 10_000_000,
             max_call_levels: 64,
             max_string_size: 1 << 20,
-            max_array_size: 1 << 20,
-            max_map_size: 1 << 16,
+            max_array_size: 10_000,
+            max_map_size: 10_000,
             max_spawns_per_step: 100_000,
         }
     }

@@ -306,7 +306,7 @@ impl<V: Vector> State<V> {
             return Err(Error::InvalidCritter {
                 critter: who(),
                 field: "position",
-                value: format!("{:?}", spec.pos),
+                value: fmt_vec(spec.pos),
                 reason: "every coordinate must be a finite number".into(),
             });
         }
@@ -329,7 +329,7 @@ impl<V: Vector> State<V> {
             return Err(Error::InvalidCritter {
                 critter: who(),
                 field: "velocity",
-                value: format!("{:?}", spec.vel),
+                value: fmt_vec(spec.vel),
                 reason: "every component must be a finite number".into(),
             });
         }

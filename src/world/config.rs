@@ -5,6 +5,7 @@ use crate::broad_phase::BroadPhaseMode;
 use crate::error::Error;
 use crate::method::Method;
 use crate::vector::Vector;
+use crate::world::fmt_vec;
 
 /// The settings a world is made with.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,7 +92,7 @@ impl<V: Vector> WorldConfig<V> {
         if !self.min.all_finite() || !self.max.all_finite() {
             return bad(
                 "box",
-                format!("{:?} to {:?}", self.min, self.max),
+                format!("{} to {}", fmt_vec(self.min), fmt_vec(self.max)),
                 "corners must be finite",
             );
         }
@@ -100,13 +101,13 @@ impl<V: Vector> WorldConfig<V> {
             if !positive {
                 return bad(
                     "size",
-                    format!("{:?}", self.max - self.min),
+                    fmt_vec(self.max - self.min),
                     "the world box must have a positive size along every axis",
                 );
             }
         }
         if !self.gravity.all_finite() {
-            return bad("gravity", format!("{:?}", self.gravity), "must be finite");
+            return bad("gravity", fmt_vec(self.gravity), "must be finite");
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad(

@@ -26,6 +26,9 @@ pub struct RunArgs {
     /// Most operations one script call may run before it is stopped (endless-loop guard).
     #[arg(long, default_value_t = Limits::default().max_operations, help_heading = "Script limits")]
     pub max_ops: u64,
+    /// Most operations all script calls of one step may run together (0: no budget).
+    #[arg(long, default_value_t = Limits::default().max_step_operations, help_heading = "Script limits")]
+    pub max_step_ops: u64,
     /// Most spawns scripts may request in one step.
     #[arg(long, default_value_t = Limits::default().max_spawns_per_step, help_heading = "Script limits")]
     pub max_spawns: u64,
@@ -35,10 +38,10 @@ pub struct RunArgs {
     /// Longest string a script may build (bytes).
     #[arg(long, default_value_t = Limits::default().max_string_size, help_heading = "Script limits")]
     pub max_string: usize,
-    /// Longest array a script may build.
+    /// Longest array a script may build (items of nested arrays count too).
     #[arg(long, default_value_t = Limits::default().max_array_size, help_heading = "Script limits")]
     pub max_array: usize,
-    /// Largest map a script may build.
+    /// Largest map a script may build (entries of nested maps count too).
     #[arg(long, default_value_t = Limits::default().max_map_size, help_heading = "Script limits")]
     pub max_map: usize,
     /// List the built-in scenes and exit.
@@ -389,6 +392,7 @@ impl Default for RunArgs {
 pub(crate) fn limits(args: &RunArgs) -> Limits {
     Limits {
         max_operations: args.max_ops,
+        max_step_operations: args.max_step_ops,
         max_spawns_per_step: args.max_spawns,
         max_call_levels: args.max_call_depth,
         max_string_size: args.max_string,

@@ -82,7 +82,8 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
 fn set_vec<V: Vector>(slot: &mut V, v: DVec3, what: &str) -> Res<()> {
     if !v.is_finite() {
         return fail(format!(
-            "{what} = {v}: every component must be a finite number"
+            "{what} = {}: every component must be a finite number",
+            crate::world::fmt_vec(from_svec::<V>(v))
         ));
     }
     *slot = from_svec(v);
@@ -207,7 +208,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         None if v.is_unit() => c.set_color(None).map_err(lib_err),
         None => fail(format!(
             "color must be a string (a colour name or \"#rrggbb\"), or () for the kind's colour; got {}",
-            v.type_name()
+            super::values::type_of(&v)
         )),
     }
     });

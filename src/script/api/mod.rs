@@ -14,6 +14,8 @@
 //! - [`kind_decl`]: what a kind file's top level declares (`extends`, `defaults`);
 //! - [`scene`]: building a scene's world: `world(#{ ... })`, walls, spawning patterns, `spawn`.
 //!
+//! [`step_ops`] is the operations budget of a step (`--max-step-ops`).
+//!
 //! [`values`] converts between script values and the engine's, and [`spawn`] turns spawn maps
 //! into spawns; both serve the capabilities above.
 
@@ -26,6 +28,7 @@ mod random;
 mod rules;
 mod scene;
 mod spawn;
+mod step_ops;
 mod test_only;
 mod values;
 mod vars;
@@ -91,9 +94,10 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     engine.set_max_array_size(limits.max_array_size);
     engine.set_max_map_size(limits.max_map_size);
     engine.set_fail_on_invalid_map_property(true);
+    step_ops::install(&mut engine, host, limits.max_step_operations);
 
     rules::register(&mut engine, host);
-    vec::register(&mut engine);
+    vec::register(&mut engine, host);
     critter::register(&mut engine, host);
     hooks::register(&mut engine, host);
     world::register(&mut engine, host);

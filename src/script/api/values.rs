@@ -3,7 +3,8 @@
 use super::{fail, CritterRef, Res};
 use crate::critter::{PropValue, Props};
 use crate::vector::Vector;
-use glam::DVec3;
+use crate::world::fmt_vec;
+use glam::{DVec2, DVec3};
 use rhai::{Array, Dynamic, ImmutableString, Map, INT};
 
 /// A number from a script value (INT or FLOAT).
@@ -21,12 +22,68 @@ pub(crate) fn num_or(d: &Dynamic, what: &str) -> Res<f64> {
         || {
             fail(format!(
                 "{what} must be a number, got {} ({})",
-                d,
-                d.type_name()
+                show(d),
+                type_of(d)
             ))
         },
         Ok,
     )
+}
+
+/// A script `Vec` as users write one, in a world of `dim` dimensions: `(5, NaN)` in 2D, where
+/// the script side's z (always 0) is left out, `(5, NaN, 1)` in 3D.
+pub(crate) fn show_vec(v: DVec3, dim: usize) -> String {
+    if dim == 2 {
+        fmt_vec(DVec2::new(v.x, v.y))
+    } else {
+        fmt_vec(v)
+    }
+}
+
+/// The dimension a `Vec` belongs to when no world says: 2 when its z is 0.
+pub(crate) fn guess_dim(v: DVec3) -> usize {
+    if v.z == 0.0 {
+        2
+    } else {
+        3
+    }
+}
+
+/// A script value for an error message, as users write it: vectors as `(x, y)`, inside arrays
+/// and maps too (rhai's own text of a `Vec` is its Rust type's name).
+pub(crate) fn show(d: &Dynamic) -> String {
+    if let Some(v) = d.clone().try_cast::<DVec3>() {
+        return show_vec(v, guess_dim(v));
+    }
+    if let Some(c) = d.clone().try_cast::<CritterRef>() {
+        return format!("critter {}", c.0);
+    }
+    if let Some(a) = d.read_lock::<Array>() {
+        let items: Vec<String> = a.iter().map(show).collect();
+        return format!("[{}]", items.join(", "));
+    }
+    if let Some(m) = d.read_lock::<Map>() {
+        let items: Vec<String> = m
+            .iter()
+            .map(|(k, v)| format!("{:?}: {}", k.as_str(), show(v)))
+            .collect();
+        return format!("#{{{}}}", items.join(", "));
+    }
+    if d.is_string() {
+        return format!("{d:?}");
+    }
+    d.to_string()
+}
+
+/// The script name of a value's type (`Vec`, `Critter`), where rhai would give the Rust one.
+pub(crate) fn type_of(d: &Dynamic) -> &'static str {
+    if d.is::<DVec3>() {
+        "Vec"
+    } else if d.is::<CritterRef>() {
+        "Critter"
+    } else {
+        d.type_name()
+    }
 }
 
 /// An engine vector as a script `Vec` (z is 0 in 2D).
@@ -50,7 +107,7 @@ pub(crate) fn vec_of(d: &Dynamic, what: &str) -> Res<DVec3> {
         || {
             fail(format!(
                 "{what} must be a Vec (e.g. vec(1.0, 2.0)), got {}",
-                d.type_name()
+                type_of(d)
             ))
         },
         Ok,

@@ -107,7 +107,8 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         })
     };
     engine.register_fn("to_map", to_map.clone());
-    let show = move |v: &mut VarsRef| -> Res<String> { to_map(v).map(|m| format!("{m:?}")) };
+    let show =
+        move |v: &mut VarsRef| -> Res<String> { to_map(v).map(|m| super::values::show(&m.into())) };
     engine.register_fn("to_string", show.clone());
     engine.register_fn("to_debug", show);
 }

@@ -1,11 +1,16 @@
-//! `Vec`: a 3-vector with operators and the usual functions; 2D worlds ignore z.
+//! `Vec`: a 3-vector with operators and the usual functions; 2D worlds ignore z, and print
+//! vectors with two components.
 
-use super::values::num_or;
+use super::values::{guess_dim, num_or, show_vec};
 use super::Res;
+use crate::script::env::Env;
+use crate::script::host::{with_env, Host};
+use crate::vector::Vector;
 use glam::DVec3;
-use rhai::{Dynamic, Engine, INT};
+use rhai::{Dynamic, Engine, EvalAltResult, INT};
+use std::rc::Rc;
 
-pub(super) fn register(engine: &mut Engine) {
+pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_type_with_name::<DVec3>("Vec");
     engine.register_fn("vec", |x: Dynamic, y: Dynamic| -> Res<DVec3> {
         Ok(DVec3::new(num_or(&x, "x")?, num_or(&y, "y")?, 0.0))
@@ -44,13 +49,17 @@ pub(super) fn register(engine: &mut Engine) {
         let (s, c) = angle.sin_cos();
         DVec3::new(c * a.x - s * a.y, s * a.x + c * a.y, a.z)
     });
-    let show = |a: &mut DVec3| -> String {
-        if a.z == 0.0 {
-            format!("vec({}, {})", a.x, a.y)
-        } else {
-            format!("vec({}, {}, {})", a.x, a.y, a.z)
-        }
+    // Printed as users write vectors, in the world's dimension: `(5, NaN)` in 2D.
+    let h = host.clone();
+    let show = move |a: &mut DVec3| -> String {
+        let dim = with_env!(h, env => Ok::<_, Box<EvalAltResult>>(dim_of(env)));
+        show_vec(*a, dim.unwrap_or_else(|_| guess_dim(*a)))
     };
-    engine.register_fn("to_string", show);
+    engine.register_fn("to_string", show.clone());
     engine.register_fn("to_debug", show);
+}
+
+/// The dimension of the world behind `env`.
+fn dim_of<V: Vector>(_: &mut (dyn Env<V> + '_)) -> usize {
+    V::DIM
 }
