@@ -37,6 +37,27 @@ pub enum Error {
         /// How deep it overlaps.
         depth: f64,
     },
+    /// A critter's radius is out of range, or the critter cannot fit in the world box or
+    /// between its walls.
+    #[error("{critter}: radius {radius} {reason}")]
+    InvalidRadius {
+        /// Which critter.
+        critter: String,
+        /// The radius, as the user wrote it.
+        radius: String,
+        /// What is wrong and what to do.
+        reason: String,
+    },
+    /// A wall would be added through a live critter.
+    #[error("{wall} overlaps {critter} by {depth:.3}: move the wall or the critter (every critter's centre must be at least its radius from every wall)")]
+    WallThroughCritter {
+        /// The wall ("the wall from (0, 0) to (1, 10)").
+        wall: String,
+        /// Which critter ("critter #3 (ball at (1, 2), radius 0.5)").
+        critter: String,
+        /// How deep they overlap.
+        depth: f64,
+    },
     /// The world's settings are out of range.
     #[error("world {field} = {value}: {reason}")]
     InvalidWorld {
