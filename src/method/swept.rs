@@ -181,7 +181,16 @@ pub(crate) fn finish_after_budget<V: Vector>(
             state.dt
         ));
     }
-    flight::carry_on(state, flight, o.acc, o.at, rest, o.slow_below, o.method, stats)?;
+    flight::carry_on(
+        state,
+        flight,
+        o.acc,
+        o.at,
+        rest,
+        o.slow_below,
+        o.method,
+        stats,
+    )?;
     if o.kicked {
         discrete::collide(state, pairs, &mut Respond::Pop, state.dt, None, stats)?;
     }

@@ -5,6 +5,7 @@
 
 use super::state::State;
 use super::{fmt_vec, World};
+use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{
     check_positive, check_restitution, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET,
@@ -14,7 +15,6 @@ use crate::error::Error;
 use crate::kind::{KindDefaults, KindHooks, KindId, WALL};
 use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
-use crate::border::Border;
 use crate::wall::WallBox;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -479,7 +479,9 @@ impl<V: Vector> State<V> {
         if matches!(self.topo.border, Border::Bounce | Border::Clamp) {
             let size = self.topo.size();
             let diameter = 2.0 * radius;
-            let side = (0..V::DIM).map(|a| size.get(a)).fold(f64::INFINITY, f64::min);
+            let side = (0..V::DIM)
+                .map(|a| size.get(a))
+                .fold(f64::INFINITY, f64::min);
             if diameter > side {
                 return Err(bad(format!(
                     "does not fit in the world box {} (its diameter {} exceeds the side {}): give a radius of at most {}, or make the world larger",
@@ -495,11 +497,7 @@ impl<V: Vector> State<V> {
 
     /// The disk fits between the walls that line the world box (axis-aligned walls that cover
     /// a whole face of it, as `walls_around` adds): errors name the radius and the space left.
-    fn check_fits_between_walls(
-        &self,
-        who: impl Fn() -> String,
-        radius: f64,
-    ) -> Result<(), Error> {
+    fn check_fits_between_walls(&self, who: impl Fn() -> String, radius: f64) -> Result<(), Error> {
         let (min, max) = (self.topo.min, self.topo.max);
         let (mut lo, mut hi) = (min, max);
         for &id in &self.walls {
@@ -530,7 +528,9 @@ impl<V: Vector> State<V> {
         }
         let space = hi - lo;
         let diameter = 2.0 * radius;
-        let side = (0..V::DIM).map(|a| space.get(a)).fold(f64::INFINITY, f64::min);
+        let side = (0..V::DIM)
+            .map(|a| space.get(a))
+            .fold(f64::INFINITY, f64::min);
         if diameter > side {
             return Err(Error::InvalidRadius {
                 critter: who(),

@@ -5,7 +5,10 @@
 use super::bodies::{refresh_body, Body, Status};
 use super::cells::{cell_coords, cell_key, cell_of, cells_around, cells_around_cell, interior_at};
 use super::shells::list_all_neighbours;
-use super::{Scratch, BUDGET_PER_CRITTER, CARRY_ON_FACTOR, ROUNDING_MARGIN, SHELL_FRACTION, TC_FRACTION, UNSET};
+use super::{
+    Scratch, BUDGET_PER_CRITTER, CARRY_ON_FACTOR, ROUNDING_MARGIN, SHELL_FRACTION, TC_FRACTION,
+    UNSET,
+};
 use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
