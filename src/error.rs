@@ -37,6 +37,45 @@ pub enum Error {
         /// How deep it overlaps.
         depth: f64,
     },
+    /// A critter's radius is out of range, or the critter cannot fit in the world box or
+    /// between its walls.
+    #[error("{critter}: radius {radius} {reason}")]
+    InvalidRadius {
+        /// Which critter.
+        critter: String,
+        /// The radius, as the user wrote it.
+        radius: String,
+        /// What is wrong and what to do.
+        reason: String,
+    },
+    /// A wall would be added through a live critter.
+    #[error("{wall} overlaps {critter} by {depth:.3}: move the wall or the critter (every critter's centre must be at least its radius from every wall)")]
+    WallThroughCritter {
+        /// The wall ("the wall from (0, 0) to (1, 10)").
+        wall: String,
+        /// Which critter ("critter #3 (ball at (1, 2), radius 0.5)").
+        critter: String,
+        /// How deep they overlap.
+        depth: f64,
+    },
+    /// An exact method (`event`, `swept`, `auto`) could not finish a step: its events did not
+    /// run out (an endless sequence of collisions), and moving the critters on without them
+    /// would leave the run silently wrong.
+    #[error("step {step}: the {method} step gave up after {events} events, {at:.3e} into a step of {dt:e}, on {pair}: the collisions do not run out in this step (an endless sequence, or a step far longer than the time between them); take a shorter --dt, or a method that is not exact (--method solve:8 for critters at rest, substep:N)")]
+    EndlessEvents {
+        /// The step (counted from 0, as errors count steps).
+        step: u64,
+        /// The method that gave up.
+        method: &'static str,
+        /// The events processed in the step before it gave up.
+        events: u64,
+        /// The time into the step where it gave up.
+        at: f64,
+        /// The step's length.
+        dt: f64,
+        /// The event it gave up on ("ball 3v0 and wall 17v0").
+        pair: String,
+    },
     /// The world's settings are out of range.
     #[error("world {field} = {value}: {reason}")]
     InvalidWorld {

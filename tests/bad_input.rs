@@ -515,11 +515,11 @@ fn extreme_valid_sizes_and_speeds_do_not_panic_or_produce_nan() {
                 .vel(DVec2::new(1e12, -1e12)),
         )
         .unwrap();
-    // A ball bigger than the box in one direction.
+    // A ball as wide as the box in one direction.
     let mut thin = World::new(WorldConfig::new(DVec2::ZERO, DVec2::new(10.0, 0.5))).unwrap();
     thin.spawn(
         CritterSpec::ball(DVec2::new(5.0, 0.25))
-            .radius(1.0)
+            .radius(0.25)
             .vel(DVec2::new(1.0, 1.0)),
     )
     .unwrap();

@@ -289,3 +289,135 @@ fn bad_methods_are_clear_errors() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(field(&stdout(&o), "method"), "substep:3");
 }
+
+/// A scratch folder for scene files written by a test.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("critterbox-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+#[test]
+fn an_impossible_radius_is_an_error_naming_the_radius_and_the_box() {
+    let dir = scratch("radius");
+    let scene = dir.join("big.rhai");
+    std::fs::write(
+        &scene,
+        "const R = 0.5;\nworld(#{ dim: 2, size: vec(10, 10) });\nspawn(\"ball\", #{ pos: vec(5, 5), radius: R });\n",
+    )
+    .expect("write");
+    let path = scene.to_str().expect("utf-8");
+    let o = critterbox(&["run", path, "--steps", "1", "--no-record"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (r, says) in [
+        ("100.0", "radius 100 does not fit in the world box 10 x 10"),
+        ("1e300", "radius 1e300 is too large"),
+        ("1e-300", "radius 1e-300 is too small"),
+    ] {
+        let set = format!("R={r}");
+        let o = critterbox(&["run", path, "--set", &set, "--steps", "1", "--no-record"]);
+        assert_eq!(o.status.code(), Some(1), "{r}");
+        let err = stderr(&o);
+        assert!(err.contains(says), "{err}");
+        assert!(err.contains("big.rhai:3"), "{err}");
+        assert!(!err.contains("mass ="), "{err}");
+    }
+}
+
+#[test]
+fn a_wall_through_a_critter_is_an_error_in_either_order() {
+    let dir = scratch("wall-order");
+    let spawn = "spawn(\"ball\", #{ pos: vec(5, 5), radius: 0.5 });\n";
+    let wall = "w.wall(vec(2, 5.2), vec(8, 5.2));\n";
+    for (name, body) in [
+        ("after", format!("{spawn}{wall}")),
+        ("before", format!("{wall}{spawn}")),
+    ] {
+        let scene = dir.join(format!("{name}.rhai"));
+        std::fs::write(
+            &scene,
+            format!("let w = world(#{{ dim: 2, size: vec(10, 10) }});\n{body}"),
+        )
+        .expect("write");
+        let o = critterbox(&[
+            "run",
+            scene.to_str().expect("utf-8"),
+            "--steps",
+            "1",
+            "--no-record",
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{name}");
+        let err = stderr(&o);
+        assert!(
+            err.contains("overlaps") && err.contains("by 0.400"),
+            "{name}: {err}"
+        );
+        assert!(err.contains(&format!("{name}.rhai:3")), "{name}: {err}");
+    }
+}
+
+#[test]
+fn exact_methods_at_a_huge_dt_finish_their_steps_or_fail_naming_the_step() {
+    for method in ["event", "swept", "auto"] {
+        let args = [
+            "run",
+            "billiards",
+            "--dt",
+            "1e9",
+            "--method",
+            method,
+            "--steps",
+            "3",
+            "--no-record",
+        ];
+        let o = critterbox(&args);
+        let err = stderr(&o);
+        if o.status.success() {
+            let warned = err.matches("ran out of its event budget").count();
+            assert_eq!(warned, 1, "{method}: {err}");
+            assert!(err.contains("[step 1] warning:"), "{method}: {err}");
+        } else {
+            assert_eq!(o.status.code(), Some(1), "{method}: {err}");
+            assert!(
+                err.contains("gave up after") && err.contains("step "),
+                "{method}: {err}"
+            );
+        }
+    }
+}
+
+#[test]
+fn discrete_at_a_large_dt_warns_of_tunnelling_once_and_a_normal_run_not_at_all() {
+    for method in ["discrete", "substep:2"] {
+        let args = [
+            "run",
+            "billiards",
+            "--dt",
+            "1",
+            "--method",
+            method,
+            "--steps",
+            "20",
+            "--no-record",
+        ];
+        let o = critterbox(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(err.matches("tunnelling").count(), 1, "{method}: {err}");
+        assert!(
+            err.contains("(ball) moved") && err.contains("--method swept"),
+            "{err}"
+        );
+    }
+    let o = critterbox(&[
+        "run",
+        "billiards",
+        "--method",
+        "discrete",
+        "--steps",
+        "200",
+        "--no-record",
+    ]);
+    assert!(o.status.success());
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}

@@ -53,6 +53,50 @@ pub(crate) fn substeps<V: Vector>(
     Ok(())
 }
 
+/// [`substeps`] under Pop's response, watching for a critter that moves farther than its
+/// radius in a substep (it may tunnel through a wall or a critter): the first one found, by
+/// slot, is named in the step's log. The state is what [`substeps`] gives, bit for bit.
+/// Returns true when it warned.
+pub(crate) fn substeps_watching<V: Vector>(
+    state: &mut State<V>,
+    pairs: &mut Pairs<V>,
+    span: f64,
+    n: u32,
+    stats: &mut StepStats,
+) -> Result<bool, Error> {
+    let h = span / f64::from(n);
+    let mut far = None;
+    for _ in 0..n {
+        let check = pairs.move_check();
+        let (moved, found) = timed(&mut stats.moving, || {
+            motion::run_watching::<V, true>(state, h, &[], &check)
+        });
+        if far.is_none() {
+            far = found.and_then(|(slot, d)| state.critters.slot(slot as u32).map(|c| (c.id, d)));
+        }
+        collide(state, pairs, &mut Respond::Pop, h, Some(moved), stats)?;
+    }
+    let Some((id, distance)) = far else {
+        return Ok(false);
+    };
+    let Some(c) = state.critters.get(id) else {
+        return Ok(false);
+    };
+    // Substeps that would move this critter at most its radius each.
+    let enough = (f64::from(n) * distance / c.radius).ceil();
+    let suggest = format!(
+        "--method swept or --method event would not tunnel, nor would --method substep:{enough} for this critter's speed"
+    );
+    let per = if n == 1 { "step" } else { "substep" };
+    state.events.log.push(format!(
+        "warning: critter {id} ({}) moved {:.3e} in one {per}, farther than its radius {}: it may pass through walls and critters (tunnelling); {suggest} (said once per run)",
+        state.kinds.name(c.kind()),
+        distance,
+        c.radius,
+    ));
+    Ok(true)
+}
+
 /// Finds the touching pairs where the critters are now and responds, after a move of `h`
 /// (`moved` is its report, when the move ran just before).
 pub(crate) fn collide<V: Vector>(

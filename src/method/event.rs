@@ -13,7 +13,7 @@
 
 use super::flight;
 use crate::error::Error;
-use crate::method::swept::{finish_in_substeps, motion_scale, SWEEP_FRACTION};
+use crate::method::swept::{finish_after_budget, motion_scale, Overrun, SWEEP_FRACTION};
 use crate::vector::Vector;
 use crate::world::stages::pairs::Pairs;
 use crate::world::state::State;
@@ -31,9 +31,15 @@ pub(crate) fn step<V: Vector>(
     let stopped = flight::run(state, flight, g, dt, None, true, stats)?;
     stats.response += clock.elapsed();
     if let Some(at) = stopped {
-        stats.budget_exceeded += 1;
-        let limit = SWEEP_FRACTION * motion_scale(state).smallest();
-        finish_in_substeps(state, pairs, dt - at, limit, false, stats)?;
+        let overrun = Overrun {
+            method: "event",
+            acc: g,
+            at,
+            limit: SWEEP_FRACTION * motion_scale(state).smallest(),
+            kicked: false,
+            slow_below: None,
+        };
+        finish_after_budget(state, pairs, flight, overrun, stats)?;
     }
     Ok(())
 }

@@ -23,6 +23,8 @@ pub(crate) struct MethodState<V: Vector> {
     pub(super) flight: flight::Scratch<V>,
     solve: solve::Scratch<V>,
     sleep: Sleep<V>,
+    /// The run was told once that a discrete step moved a critter farther than its radius.
+    warned_tunnel: bool,
 }
 
 /// What a step is taken with (under `auto`, what it chose for this step).
@@ -45,6 +47,7 @@ impl<V: Vector> MethodState<V> {
             flight: Default::default(),
             solve: Default::default(),
             sleep: Sleep::new(sleep),
+            warned_tunnel: false,
         }
     }
 
@@ -109,7 +112,18 @@ impl<V: Vector> MethodState<V> {
             self.sleep.clear();
         }
         let dt = state.dt;
+        // `auto` takes the discrete step only where nobody moves far: it is not watched.
+        let watch = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
+        let watching = !self.warned_tunnel && watch(self.method) && watch(plan.method);
         match plan.method {
+            Method::Discrete | Method::Substep(_) if watching => {
+                let n = match plan.method {
+                    Method::Substep(n) => n.max(1),
+                    _ => 1,
+                };
+                self.warned_tunnel = discrete::substeps_watching(state, pairs, dt, n, stats)?;
+                Ok(())
+            }
             Method::Discrete | Method::Auto => {
                 discrete::substeps(state, pairs, &mut Respond::Pop, dt, 1, stats)
             }
@@ -132,7 +146,10 @@ impl<V: Vector> MethodState<V> {
     /// Forgets everything kept between steps (the world was put in a recorded state).
     pub(crate) fn forget(&mut self) {
         self.auto_choice = None;
+        // The warnings are said once per run, restored or not.
+        let warned = self.flight.warned_budget;
         self.flight = Default::default();
+        self.flight.warned_budget = warned;
         self.solve = Default::default();
         self.sleep.forget();
     }

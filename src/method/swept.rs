@@ -125,10 +125,95 @@ pub(crate) fn step<V: Vector>(
     match stopped {
         None => discrete::collide(state, pairs, &mut Respond::Pop, dt, None, stats),
         Some(at) => {
-            stats.budget_exceeded += 1;
-            finish_in_substeps(state, pairs, dt - at, limit, true, stats)
+            let overrun = Overrun {
+                method: "swept",
+                acc: V::zero(),
+                at,
+                limit,
+                kicked: true,
+                slow_below: fast,
+            };
+            finish_after_budget(state, pairs, flight, overrun, stats)
         }
     }
+}
+
+/// Where and how a swept or event step ran out of its event budget.
+pub(crate) struct Overrun<V> {
+    /// The step's method, for messages.
+    pub(crate) method: &'static str,
+    /// The flight's acceleration (gravity for `event`; `swept` gave its kick up front).
+    pub(crate) acc: V,
+    /// The time into the step where the budget ran out.
+    pub(crate) at: f64,
+    /// The most a discrete substep may move a critter without tunnelling.
+    pub(crate) limit: f64,
+    /// Swept: gravity's kick was given up front, and a discrete pass closes the step.
+    pub(crate) kicked: bool,
+    /// The flight's `slow_below` (see [`flight::run`]).
+    pub(crate) slow_below: Option<f64>,
+}
+
+/// Finishes a step whose flight ran out of its event budget: in discrete substeps when at most
+/// [`MOST_TAIL_SUBSTEPS`] of them take the rest without tunnelling (resting contacts under
+/// gravity), else by carrying the flight on with every event ([`flight::carry_on`], which
+/// errs when the events do not run out), so that no critter moves past its events. The first
+/// step of a run that carries on says so in the step's log.
+pub(crate) fn finish_after_budget<V: Vector>(
+    state: &mut State<V>,
+    pairs: &mut Pairs<V>,
+    flight: &mut flight::Scratch<V>,
+    o: Overrun<V>,
+    stats: &mut StepStats,
+) -> Result<(), Error> {
+    stats.budget_exceeded += 1;
+    let rest = state.dt - o.at;
+    if tail_substeps(state, rest, o.limit, o.kicked) <= f64::from(MOST_TAIL_SUBSTEPS) {
+        return finish_in_substeps(state, pairs, rest, o.limit, o.kicked, stats);
+    }
+    if !flight.warned_budget {
+        flight.warned_budget = true;
+        state.events.log.push(format!(
+            "warning: the {} step ran out of its event budget ({} events) {:.3e} into the step of {:e}; it carries on to the step's end with every event, which may be slow (a shorter --dt keeps steps within the budget)",
+            o.method,
+            flight.budget(),
+            o.at,
+            state.dt
+        ));
+    }
+    flight::carry_on(
+        state,
+        flight,
+        o.acc,
+        o.at,
+        rest,
+        o.slow_below,
+        o.method,
+        stats,
+    )?;
+    if o.kicked {
+        discrete::collide(state, pairs, &mut Respond::Pop, state.dt, None, stats)?;
+    }
+    Ok(())
+}
+
+/// The discrete substeps [`finish_in_substeps`] needs so that none moves a critter more than
+/// `limit` (before it clamps them to [`MOST_TAIL_SUBSTEPS`]); NaN when a speed is not finite.
+fn tail_substeps<V: Vector>(world: &State<V>, rest: f64, limit: f64, kicked: bool) -> f64 {
+    let g = world.gravity;
+    let mut fastest: f64 = 0.0;
+    for c in world.critters.iter() {
+        if c.alive && !c.is_wall() {
+            // The same arithmetic as `finish_in_substeps`, without changing the velocities.
+            let v = if kicked && !c.fixed {
+                c.vel - g * rest
+            } else {
+                c.vel
+            };
+            fastest = fastest.max(v.length() + g.length() * rest);
+        }
+    }
+    (fastest * rest / limit).ceil()
 }
 
 /// Finishes a step whose flight ran out of its event budget (resting contacts under gravity)

@@ -5,6 +5,7 @@
 
 use super::state::State;
 use super::{fmt_vec, World};
+use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{
     check_positive, check_restitution, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET,
@@ -33,6 +34,13 @@ pub(crate) enum OnOverlap {
     /// [`MAX_PUSHES`] moves, kept inside the world box); not added if it still overlaps then.
     Push,
 }
+
+/// The largest radius a critter may have: its mass, density x radius^3, stays far from
+/// overflowing f64 (about 1e308), and so do the squared distances the contacts compute.
+pub const MAX_RADIUS: f64 = 1e100;
+/// The smallest radius a critter may have: its mass, density x radius^3, stays far from
+/// underflowing to zero.
+pub const MIN_RADIUS: f64 = 1e-100;
 
 /// Moves `OnOverlap::Push` makes before it gives up.
 pub(crate) const MAX_PUSHES: usize = 16;
@@ -149,6 +157,7 @@ impl<V: Vector> State<V> {
     /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
     pub(crate) fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
         wall.validate()?;
+        self.check_clear_of_critters(&wall)?;
         let center = wall.center;
         let radius = wall.bounding_radius();
         let id = self.critters.insert(|id| Critter {
@@ -201,6 +210,11 @@ impl<V: Vector> State<V> {
             Err(_) => return self.spawn(spec).map(Placed::Added),
         };
         let fits = spec.pos.all_finite() && radius.is_finite() && radius > 0.0;
+        if fits && on_overlap != OnOverlap::Error {
+            // An impossible radius is an error whatever the policy: pushing cannot fix it.
+            let who = || format!("the {} spawned at {}", spec.kind, fmt_vec(spec.pos));
+            self.check_radius(who, radius)?;
+        }
         match on_overlap {
             OnOverlap::Error => return self.spawn(spec).map(Placed::Added),
             _ if !fits => return self.spawn(spec).map(Placed::Added),
@@ -335,12 +349,27 @@ impl<V: Vector> State<V> {
         }
         let radius = spec.radius.unwrap_or(d.radius);
         check_positive(who, "radius", radius)?;
+        self.check_radius(who, radius)?;
         let density = spec.density.unwrap_or(d.density);
         check_positive(who, "density", density)?;
         let mass = spec
             .mass
             .or(if spec.density.is_some() { None } else { d.mass });
+        let derived = mass.is_none();
         let mass = mass.unwrap_or(density * radius * radius * radius);
+        if derived && !(mass.is_finite() && mass > 0.0) {
+            // The user gave the density and the radius, not the mass: name those.
+            return Err(Error::InvalidCritter {
+                critter: who(),
+                field: "density",
+                value: fmt_number(density),
+                reason: format!(
+                    "with radius {} it gives the mass density x radius^3 = {}; give a density nearer 1, or the mass itself",
+                    fmt_number(radius),
+                    fmt_number(mass)
+                ),
+            });
+        }
         check_positive(who, "mass", mass)?;
         let restitution = spec.restitution.unwrap_or(d.restitution);
         check_restitution(who, restitution)?;
@@ -409,5 +438,147 @@ impl<V: Vector> State<V> {
                 color: None,
             }),
         })
+    }
+}
+
+/// `x` as a user writes it: plain for ordinary sizes, `1e300` for extreme ones.
+fn fmt_number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The box's sides, `10 x 10` (or `10 x 10 x 10`).
+fn fmt_sides<V: Vector>(size: V) -> String {
+    let sides: Vec<String> = (0..V::DIM).map(|a| fmt_number(size.get(a))).collect();
+    sides.join(" x ")
+}
+
+impl<V: Vector> State<V> {
+    /// A radius (finite and positive) within [`MIN_RADIUS`]..=[`MAX_RADIUS`] and whose disk
+    /// fits in the world box when the border bounds it (bounce, clamp): errors name the radius
+    /// and the box.
+    fn check_radius(&self, who: impl Fn() -> String, radius: f64) -> Result<(), Error> {
+        let bad = |reason: String| Error::InvalidRadius {
+            critter: who(),
+            radius: fmt_number(radius),
+            reason,
+        };
+        if radius > MAX_RADIUS {
+            return Err(bad(format!(
+                "is too large: a radius is at most {MAX_RADIUS:e} (beyond it the mass, density x radius^3, is not a finite number)"
+            )));
+        }
+        if radius < MIN_RADIUS {
+            return Err(bad(format!(
+                "is too small: a radius is at least {MIN_RADIUS:e} (below it the mass, density x radius^3, is zero)"
+            )));
+        }
+        if matches!(self.topo.border, Border::Bounce | Border::Clamp) {
+            let size = self.topo.size();
+            let diameter = 2.0 * radius;
+            let side = (0..V::DIM)
+                .map(|a| size.get(a))
+                .fold(f64::INFINITY, f64::min);
+            if diameter > side {
+                return Err(bad(format!(
+                    "does not fit in the world box {} (its diameter {} exceeds the side {}): give a radius of at most {}, or make the world larger",
+                    fmt_sides(size),
+                    fmt_number(diameter),
+                    fmt_number(side),
+                    fmt_number(0.5 * side)
+                )));
+            }
+        }
+        self.check_fits_between_walls(who, radius)
+    }
+
+    /// The disk fits between the walls that line the world box (axis-aligned walls that cover
+    /// a whole face of it, as `walls_around` adds): errors name the radius and the space left.
+    fn check_fits_between_walls(&self, who: impl Fn() -> String, radius: f64) -> Result<(), Error> {
+        let (min, max) = (self.topo.min, self.topo.max);
+        let (mut lo, mut hi) = (min, max);
+        for &id in &self.walls {
+            let Some(Shape::Wall(geom)) = self.critters.get(id).map(|c| c.shape()) else {
+                continue;
+            };
+            if geom.frame != V::identity_frame() {
+                continue;
+            }
+            let (a, b) = (geom.center - geom.half, geom.center + geom.half);
+            for axis in 0..V::DIM {
+                let covers_face = (0..V::DIM)
+                    .filter(|&o| o != axis)
+                    .all(|o| a.get(o) <= min.get(o) && b.get(o) >= max.get(o));
+                if !covers_face {
+                    continue;
+                }
+                if a.get(axis) <= min.get(axis) && b.get(axis) < max.get(axis) {
+                    lo.set(axis, lo.get(axis).max(b.get(axis)));
+                }
+                if b.get(axis) >= max.get(axis) && a.get(axis) > min.get(axis) {
+                    hi.set(axis, hi.get(axis).min(a.get(axis)));
+                }
+            }
+        }
+        if lo == min && hi == max {
+            return Ok(());
+        }
+        let space = hi - lo;
+        let diameter = 2.0 * radius;
+        let side = (0..V::DIM)
+            .map(|a| space.get(a))
+            .fold(f64::INFINITY, f64::min);
+        if diameter > side {
+            return Err(Error::InvalidRadius {
+                critter: who(),
+                radius: fmt_number(radius),
+                reason: format!(
+                    "does not fit between the walls lining the world box, {} to {}, a space of {} (its diameter {} exceeds the side {}): give a radius of at most {}",
+                    fmt_vec(lo),
+                    fmt_vec(hi),
+                    fmt_sides(space),
+                    fmt_number(diameter),
+                    fmt_number(side),
+                    fmt_number(0.5 * side.max(0.0))
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// A new wall must not reach into a live critter, as a new critter must not reach into a
+    /// wall ([`Error::SpawnInsideWall`]): both orders are errors.
+    fn check_clear_of_critters(&self, wall: &WallBox<V>) -> Result<(), Error> {
+        for c in self.critters.iter() {
+            if !c.alive || c.is_wall() {
+                continue;
+            }
+            let d = self.topo.delta(wall.center, c.pos);
+            let Some(hit) = contact_wall_ball(wall, d, c.radius) else {
+                continue;
+            };
+            if hit.depth > ROUNDING_MARGIN * c.radius.max(1.0) {
+                let size = wall.aabb_half() * 2.0;
+                return Err(Error::WallThroughCritter {
+                    wall: format!(
+                        "the wall at {} (size {})",
+                        fmt_vec(wall.center),
+                        fmt_sides(size)
+                    ),
+                    critter: format!(
+                        "critter {} ({} at {}, radius {})",
+                        c.id,
+                        self.kinds.name(c.kind()),
+                        fmt_vec(c.pos),
+                        fmt_number(c.radius)
+                    ),
+                    depth: hit.depth,
+                });
+            }
+        }
+        Ok(())
     }
 }

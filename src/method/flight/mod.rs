@@ -27,7 +27,10 @@
 //! shorter intervals. An event budget per step bounds the cost of what remains (resting
 //! contacts under gravity); when it runs out (counted in `StepStats::budget_exceeded`) the
 //! critters are stopped where they are, and `swept` and `event` finish the step in discrete
-//! substeps short enough not to tunnel.
+//! substeps short enough not to tunnel, when a few of them do. Otherwise (a step far longer
+//! than the time between collisions) no critter may move without its events: the step carries
+//! on with them ([`carry_on`], with a warning once per run), up to [`CARRY_ON_FACTOR`] times the
+//! budget, and past that it is an error naming the step and the event.
 //!
 //! Kept flights ([`kept`]): an event step whose flights are straight lines (no gravity) and in
 //! which everyone predicts keeps its flight for the next step: the pending events stay in the
@@ -81,6 +84,10 @@ pub const TC_FRACTION: f64 = 1e-9;
 /// Events per critter per step before the step falls back to discrete substeps: bounds the cost
 /// of resting contacts under gravity, which never run out of events.
 pub const BUDGET_PER_CRITTER: u64 = 64;
+/// A step whose rest the discrete substeps cannot take without tunnelling carries on with its
+/// events instead ([`carry_on`]), up to this many times the budget: beyond it the events are
+/// taken to be endless (Zeno) and the step is an error.
+pub const CARRY_ON_FACTOR: u64 = 16;
 /// Neighbour shells' thickness, as a fraction of the largest diameter: thinner shells are
 /// left more often, thicker ones list more partners (`docs/methods.md` has the trade).
 pub const SHELL_FRACTION: f64 = 0.6;
@@ -182,6 +189,14 @@ pub(crate) struct Scratch<V: Vector> {
     tc_window: f64,
     /// Events the flight may process before it stops.
     budget: u64,
+    /// The flight carries a step on past its budget ([`carry_on`]): its budget is
+    /// [`CARRY_ON_FACTOR`] times the usual.
+    carrying_on: bool,
+    /// Events the last flight processed, and the event it stopped at when its budget ran out.
+    processed: u64,
+    stopped_on: Option<Event>,
+    /// The run was told once that a step carried on past its budget.
+    pub(crate) warned_budget: bool,
     /// Predictions made and pair tests run in this flight (for the step's stats).
     predictions: u64,
     pair_tests: u64,
@@ -202,9 +217,17 @@ pub(crate) struct Scratch<V: Vector> {
     churned_at: Option<u64>,
 }
 
+impl<V: Vector> Scratch<V> {
+    /// The events the last flight might process before it stopped.
+    pub(crate) fn budget(&self) -> u64 {
+        self.budget
+    }
+}
+
 /// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
 /// processing every event in order. Returns `None` when every event was processed, or the time
-/// the event budget ran out, where the critters were stopped (the caller finishes the step).
+/// the event budget ran out, where the critters were stopped (the caller finishes the step, in
+/// discrete substeps that cannot tunnel or with [`carry_on`]).
 ///
 /// `slow_below`: when set, a critter that moves less than it in the flight predicts at the
 /// start only if it may meet something along its line (`may_meet`); otherwise it joins in when
@@ -252,6 +275,63 @@ pub(crate) fn run<V: Vector>(
         sc.queue.reset(0, 0.0, 0.0);
     }
     out
+}
+
+/// Carries a step on for `span` from where its budget ran out, in a new flight with
+/// [`CARRY_ON_FACTOR`] times the budget, so that no critter moves without its events. When that
+/// runs out too, the events are endless in this step: an [`Error::EndlessEvents`] naming the
+/// step and the event it gave up on. `at`: the flight time the step had reached; `method`: the
+/// step's method, for the error.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn carry_on<V: Vector>(
+    w: &mut State<V>,
+    sc: &mut Scratch<V>,
+    acc: V,
+    at: f64,
+    span: f64,
+    slow_below: Option<f64>,
+    method: &'static str,
+    stats: &mut StepStats,
+) -> Result<(), Error> {
+    let before = sc.processed;
+    sc.carrying_on = true;
+    let out = run(w, sc, acc, span, slow_below, false, stats);
+    sc.carrying_on = false;
+    let Some(stopped) = out? else {
+        return Ok(());
+    };
+    let pair = match sc.stopped_on.take() {
+        Some(ev) => describe(w, sc, &ev),
+        None => "an event".to_string(),
+    };
+    Err(Error::EndlessEvents {
+        step: w.step_count,
+        method,
+        events: before + sc.processed,
+        at: at + stopped,
+        dt: w.dt,
+        pair,
+    })
+}
+
+/// The critters of event `ev`, in words: its owner and what the owner last collided with
+/// (the pair an endless sequence repeats), or its partner when it has not collided yet.
+fn describe<V: Vector>(w: &State<V>, sc: &Scratch<V>, ev: &Event) -> String {
+    let name = |x: u32| match w.critters.slot(x) {
+        Some(c) if c.is_wall() => format!("wall {}", c.id),
+        Some(c) => format!("critter {} ({})", c.id, w.kinds.name(c.kind())),
+        None => format!("slot {x}"),
+    };
+    let owner = name(ev.owner);
+    match sc.last_partner.get(ev.owner as usize).copied() {
+        Some(p) if p < BORDER_PARTNER => format!("{owner} and {}", name(p)),
+        Some(p) if p < UNSET => format!("{owner} and the border"),
+        _ => match ev.kind {
+            EventKind::Pair | EventKind::Wall => format!("{owner} and {}", name(ev.other)),
+            EventKind::Border => format!("{owner} and the border"),
+            _ => owner,
+        },
+    }
 }
 
 /// Flies the critters to `t_end` in new flights: one, unless a hook grows a critter beyond the
@@ -357,6 +437,7 @@ fn fly<V: Vector>(
         processed += 1;
         if processed > sc.budget {
             stopped = Some(ev.time);
+            sc.stopped_on = Some(ev);
             break;
         }
         let t = ev.time;
@@ -453,7 +534,8 @@ fn fly<V: Vector>(
             }
         }
     }
-    stats.events += processed.min(sc.budget);
+    sc.processed = processed.min(sc.budget);
+    stats.events += sc.processed;
     stats.pair_tests += sc.pair_tests;
     stats.candidates += sc.predictions as usize;
     // Everyone to the end of the flight.

@@ -5,7 +5,10 @@
 use super::bodies::{refresh_body, Body, Status};
 use super::cells::{cell_coords, cell_key, cell_of, cells_around, cells_around_cell, interior_at};
 use super::shells::list_all_neighbours;
-use super::{Scratch, BUDGET_PER_CRITTER, ROUNDING_MARGIN, SHELL_FRACTION, TC_FRACTION, UNSET};
+use super::{
+    Scratch, BUDGET_PER_CRITTER, CARRY_ON_FACTOR, ROUNDING_MARGIN, SHELL_FRACTION, TC_FRACTION,
+    UNSET,
+};
 use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
@@ -64,6 +67,10 @@ pub(super) fn setup<V: Vector>(
     sc.predictions = 0;
     sc.pair_tests = 0;
     sc.budget = BUDGET_PER_CRITTER * disks as u64 + 10_000;
+    if sc.carrying_on {
+        sc.budget *= CARRY_ON_FACTOR;
+    }
+    sc.stopped_on = None;
     // Shells pay where a cell's neighbourhood is large (27 cells) and flights are lines.
     sc.shells = sc.straight && !sc.has_walls && V::DIM == 3 && disks > 0 && sc.slow_below.is_none();
     #[cfg(test)]
