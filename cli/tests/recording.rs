@@ -425,7 +425,7 @@ fn a_script_error_is_written_into_the_recording_before_it_is_reported() {
     assert!(!o.status.success());
     let out = text(&o);
     assert!(out.contains("boom at seven"), "{out}");
-    assert!(out.contains("ended by error"), "the path is printed: {out}");
+    assert!(out.contains("ended: error"), "the path is printed: {out}");
     let r = Recording::open(&file).expect("the file is complete");
     assert_eq!(r.truncated, None);
     let e = r.error.as_ref().expect("an error message");

@@ -71,13 +71,15 @@ pub fn verify(
             return Ok(Flow::Continue);
         }
         let step = decode::<StepOnly>(topic, data)?.step;
-        // A step past every hash read (the error comes one after) is damage, not steps to run.
-        if step > rec.last_step().saturating_add(1) && report.mismatch.is_none() {
+        // Every step from 0 has a hash (the error comes one after the last): a step past their
+        // count is damage, not steps to re-simulate.
+        let recorded = rec.hashes.len() as u64;
+        if step > recorded && report.mismatch.is_none() {
             report.mismatch = Some(Mismatch {
                 step: replay.step_count(),
                 what: format!(
-                    "a {topic} message names step {step}, past the last step recorded ({}):                      the file is damaged",
-                    rec.last_step()
+                    "a {topic} message names step {step}, but the file holds the hashes of \
+                     {recorded} steps: the file is damaged"
                 ),
                 critter: None,
             });
