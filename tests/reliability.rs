@@ -3,10 +3,8 @@
 //! critter is an error in either order; the exact methods never end a step with critters moved
 //! past their events; the discrete step says once when it may tunnel.
 
-mod common;
 mod script_common;
 
-use common::{distance_to_aligned_box, state_bits};
 use critterbox::glam::{DVec2, DVec3};
 use critterbox::{Border, CritterSpec, Error, WallBox, World, WorldConfig};
 use script_common::*;
@@ -235,6 +233,22 @@ fn deepest_into_walls(w: &World<DVec2>) -> f64 {
         }
     }
     deepest
+}
+
+/// Distance from `p` to the box [lo, hi] (0 inside), independent of the engine's wall code.
+fn distance_to_aligned_box(p: DVec2, lo: DVec2, hi: DVec2) -> f64 {
+    (p.max(lo).min(hi) - p).length()
+}
+
+/// Every critter's id, position and velocity, as bits.
+fn state_bits(w: &World<DVec2>) -> Vec<(String, [u64; 4])> {
+    w.critters()
+        .iter()
+        .map(|c| {
+            let bits = [c.pos.x, c.pos.y, c.vel.x, c.vel.y].map(f64::to_bits);
+            (c.id().to_string(), bits)
+        })
+        .collect()
 }
 
 /// Steps `w` `steps` times; an error must be the endless-events error, naming the step.

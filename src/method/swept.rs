@@ -155,8 +155,8 @@ pub(crate) struct Overrun<V> {
 }
 
 /// Finishes a step whose flight ran out of its event budget: in discrete substeps when at most
-/// [`MOST_TAIL_SUBSTEPS`] of them take the rest without tunnelling (resting contacts under
-/// gravity), else by carrying the flight on with every event ([`flight::carry_on`], which
+/// [`MOST_TAIL_SUBSTEPS`] of them take the rest moving no critter farther than the smallest
+/// radius or wall thickness, so that none tunnels (resting contacts under gravity), else by carrying the flight on with every event ([`flight::carry_on`], which
 /// errs when the events do not run out), so that no critter moves past its events. The first
 /// step of a run that carries on says so in the step's log.
 pub(crate) fn finish_after_budget<V: Vector>(
@@ -168,7 +168,10 @@ pub(crate) fn finish_after_budget<V: Vector>(
 ) -> Result<(), Error> {
     stats.budget_exceeded += 1;
     let rest = state.dt - o.at;
-    if tail_substeps(state, rest, o.limit, o.kicked) <= f64::from(MOST_TAIL_SUBSTEPS) {
+    // `limit` is SWEEP_FRACTION of the smallest radius or wall thickness: the substeps cannot
+    // tunnel while none moves a critter farther than that smallest length itself.
+    let safe = f64::from(MOST_TAIL_SUBSTEPS) / SWEEP_FRACTION;
+    if tail_substeps(state, rest, o.limit, o.kicked) <= safe {
         return finish_in_substeps(state, pairs, rest, o.limit, o.kicked, stats);
     }
     if !flight.warned_budget {

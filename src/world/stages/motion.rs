@@ -24,6 +24,9 @@ pub(crate) fn run<V: Vector>(
     run_watching::<V, false>(state, h, still, check).0
 }
 
+/// A critter that moved farther than its radius: its slot and how far it moved.
+pub(crate) type Far = Option<(usize, f64)>;
+
 /// [`run`], and with `WATCH` the lowest slot of a critter that moved farther than its radius
 /// (so it may have passed through a wall or a critter) and how far: a comparison per critter
 /// on what the move computes anyway, and none without `WATCH`.
@@ -32,7 +35,7 @@ pub(crate) fn run_watching<V: Vector, const WATCH: bool>(
     h: f64,
     still: &[bool],
     check: &MoveCheck<'_, V>,
-) -> (MoveReport, Option<(usize, f64)>) {
+) -> (MoveReport, Far) {
     let (g, topo) = (state.gravity, state.topo);
     let dv = g * h;
     // The squared distance moved when farther than the radius, else 0.
@@ -81,7 +84,7 @@ pub(crate) fn run_watching<V: Vector, const WATCH: bool>(
         (seen, far)
     };
     // Below `PARALLEL_MIN` critters the chunks are taken in turn on this thread.
-    let chunks: Vec<(ChunkCheck<'_, V>, Option<(usize, f64)>)> = if parallel {
+    let chunks: Vec<(ChunkCheck<'_, V>, Far)> = if parallel {
         slots
             .par_chunks_mut(INPUT_CHUNK)
             .enumerate()
