@@ -16,6 +16,7 @@ fn options() -> ScriptOptions {
     ScriptOptions {
         limits: Limits {
             max_operations: 20_000,
+            max_step_operations: 200_000,
             max_call_levels: 16,
             max_string_size: 4096,
             max_array_size: 1024,

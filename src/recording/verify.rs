@@ -71,9 +71,9 @@ pub fn verify(
             return Ok(Flow::Continue);
         }
         let step = decode::<StepOnly>(topic, data)?.step;
-        // Every step from 0 has a hash (the error comes one after the last): a step past their
-        // count is damage, not steps to re-simulate.
-        let recorded = rec.hashes.len() as u64;
+        // Every step from 0 has a hash (the error comes one after the last), read or lost in a
+        // damaged stretch: a step past their count is damage, not steps to re-simulate.
+        let recorded = steps_held(rec);
         if step > recorded && report.mismatch.is_none() {
             report.mismatch = Some(Mismatch {
                 step: replay.step_count(),
@@ -220,4 +220,20 @@ pub fn verify(
     // Events recorded nowhere but present in the replay are not checked message by message;
     // the hashes and totals of every step cover the state they lead to.
     Ok(report)
+}
+
+/// How many steps the file held: the hashes read, and those the damaged stretches lost. A
+/// stretch is counted by the steps between the hashes around it, but never as more steps than
+/// the bytes it skipped (a step's hash message takes several), so a damaged step number
+/// cannot make verify re-simulate without end.
+fn steps_held(rec: &Recording) -> u64 {
+    let lost: u64 = rec
+        .gaps
+        .iter()
+        .map(|g| match g.missing() {
+            Some((first, Some(last))) => (last - first + 1).min(g.damage.skipped),
+            Some((_, None)) | None => 0,
+        })
+        .sum();
+    rec.hashes.len() as u64 + lost
 }

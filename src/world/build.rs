@@ -549,36 +549,48 @@ impl<V: Vector> State<V> {
         Ok(())
     }
 
+    /// The live critters `wall` would reach into, and by how much.
+    fn reached_by<'a>(
+        &'a self,
+        wall: &'a WallBox<V>,
+    ) -> impl Iterator<Item = (&'a Critter<V>, f64)> + 'a {
+        self.critters.iter().filter_map(move |c| {
+            if !c.alive || c.is_wall() {
+                return None;
+            }
+            let d = self.topo.delta(wall.center, c.pos);
+            let hit = contact_wall_ball(wall, d, c.radius)?;
+            (hit.depth > ROUNDING_MARGIN * c.radius.max(1.0)).then_some((c, hit.depth))
+        })
+    }
+
+    /// The critters a wall would reach into (tests clear its place before they put it down).
+    #[cfg(test)]
+    pub(crate) fn critters_under(&self, wall: &WallBox<V>) -> Vec<CritterId> {
+        self.reached_by(wall).map(|(c, _)| c.id).collect()
+    }
+
     /// A new wall must not reach into a live critter, as a new critter must not reach into a
     /// wall ([`Error::SpawnInsideWall`]): both orders are errors.
     fn check_clear_of_critters(&self, wall: &WallBox<V>) -> Result<(), Error> {
-        for c in self.critters.iter() {
-            if !c.alive || c.is_wall() {
-                continue;
-            }
-            let d = self.topo.delta(wall.center, c.pos);
-            let Some(hit) = contact_wall_ball(wall, d, c.radius) else {
-                continue;
-            };
-            if hit.depth > ROUNDING_MARGIN * c.radius.max(1.0) {
-                let size = wall.aabb_half() * 2.0;
-                return Err(Error::WallThroughCritter {
-                    wall: format!(
-                        "the wall at {} (size {})",
-                        fmt_vec(wall.center),
-                        fmt_sides(size)
-                    ),
-                    critter: format!(
-                        "critter {} ({} at {}, radius {})",
-                        c.id,
-                        self.kinds.name(c.kind()),
-                        fmt_vec(c.pos),
-                        fmt_number(c.radius)
-                    ),
-                    depth: hit.depth,
-                });
-            }
-        }
-        Ok(())
+        let Some((c, depth)) = self.reached_by(wall).next() else {
+            return Ok(());
+        };
+        let size = wall.aabb_half() * 2.0;
+        Err(Error::WallThroughCritter {
+            wall: format!(
+                "the wall at {} (size {})",
+                fmt_vec(wall.center),
+                fmt_sides(size)
+            ),
+            critter: format!(
+                "critter {} ({} at {}, radius {})",
+                c.id,
+                self.kinds.name(c.kind()),
+                fmt_vec(c.pos),
+                fmt_number(c.radius)
+            ),
+            depth,
+        })
     }
 }

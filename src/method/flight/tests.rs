@@ -226,8 +226,12 @@ fn who_may_meet_pair_by_pair_is_may_meet() {
             let mut b = mid;
             b.set(0, hi.get(0) - 2.0);
             let half = V::splat(0.05);
-            w.add_wall(crate::WallBox::aligned(a - half, b + half).expect("a box"))
-                .expect("the wall goes in");
+            let wall = crate::WallBox::aligned(a - half, b + half).expect("a box");
+            // A wall may not be put down through critters: clear its place first.
+            for id in w.state.critters_under(&wall) {
+                w.remove(id).expect("there");
+            }
+            w.add_wall(wall).expect("the wall goes in");
         }
         // Stir: a few discrete steps at speeds of several radii per second, then some disks
         // much faster.
