@@ -1,42 +1,23 @@
 //! Damaged recordings lose only what is damaged, the exit codes say so (3: damaged or cut off),
 //! and `diff` compares every recorded message, not only the hashes.
 
+mod common;
+use common::{critterbox, text};
+
 use critterbox::recording::recover::rewrite;
 use critterbox::recording::schema;
 use critterbox::recording::Recording;
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+/// A fresh folder for one test.
+fn tmp(name: &str) -> PathBuf {
+    common::tmp_in("damaged-tests", name)
+}
+
 /// The exit code of a command that read a damaged or cut-off recording.
 const DAMAGED: i32 = 3;
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("damaged-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn critterbox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_critterbox"))
-        .args(args)
-        .current_dir(ROOT)
-        .output()
-        .expect("the critterbox binary runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")

@@ -1,6 +1,9 @@
 //! Recordings: written by every run, read back bit for bit, verified by re-simulating from the
 //! file alone, recovered when cut off, and never a panic on a bad file.
 
+mod common;
+use common::{critterbox, critterbox_in, text, ROOT};
+
 use critterbox::recording::compare::first_difference;
 use critterbox::recording::reader::{for_each_state, state_at, Flow};
 use critterbox::recording::recover::rewrite;
@@ -9,40 +12,11 @@ use critterbox::recording::schema::{self, StateMsg};
 use critterbox::recording::verify::verify;
 use critterbox::recording::{capture, Recording};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-/// The repository, where the scripts and recordings are.
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+use std::process::Command;
 
 /// A fresh folder for one test.
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("recording-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn critterbox_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_critterbox"))
-        .args(args)
-        .current_dir(dir)
-        .env("CRITTERBOX_RECORDINGS", dir.join("recordings"))
-        .output()
-        .expect("the critterbox binary runs")
-}
-
-fn critterbox(args: &[&str]) -> Output {
-    critterbox_in(Path::new(ROOT), args)
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    common::tmp_in("recording-tests", name)
 }
 
 /// Runs `critterbox run ARGS --record PATH` and checks it succeeded.

@@ -3,6 +3,9 @@
 //! `me.color` in the Foxglove channel, the script profiler in `run --stats` and the recording's
 //! end metadata, the log's step numbers, and a failing test's recording.
 
+mod common;
+use common::{critterbox, critterbox_in, text, ROOT};
+
 use critterbox::recording::reader::{read_items, Flow, Item};
 use critterbox::recording::recover::rewrite;
 use critterbox::recording::replay::{state_at_step, StateSource};
@@ -11,42 +14,16 @@ use critterbox::recording::verify::verify;
 use critterbox::recording::Recording;
 use critterbox::PropValue;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+/// A fresh folder for one test.
+fn tmp(name: &str) -> PathBuf {
+    common::tmp_in("script-state-tests", name)
+}
+
 const SCENE: &str = "scripts/tests/scenes/vars_score.rhai";
 /// The scene's critters (its constant N) and their kind.
 const N: i64 = 6;
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("script-state-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn critterbox_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_critterbox"))
-        .args(args)
-        .current_dir(dir)
-        .env("CRITTERBOX_RECORDINGS", dir.join("recordings"))
-        .output()
-        .expect("the critterbox binary runs")
-}
-
-fn critterbox(args: &[&str]) -> Output {
-    critterbox_in(Path::new(ROOT), args)
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 /// Every message of `topic`, as JSON.
 fn messages(path: &Path, topic: &str) -> Vec<serde_json::Value> {

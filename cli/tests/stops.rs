@@ -2,37 +2,18 @@
 //! recording and names the signal, and a scene that cannot be built is recorded with its
 //! scripts and its error.
 
+mod common;
+use common::{critterbox_in, text};
+
 use critterbox::recording::verify::verify;
 use critterbox::recording::{Recording, SETUP_FAILED};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// A fresh folder for one test.
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("stop-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn critterbox_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_critterbox"))
-        .args(args)
-        .current_dir(dir)
-        .env("CRITTERBOX_RECORDINGS", dir.join("recordings"))
-        .output()
-        .expect("the critterbox binary runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    common::tmp_in("stop-tests", name)
 }
 
 /// Starts a run that would go on for hours, sends it `signal` once it is stepping, and checks
