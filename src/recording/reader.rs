@@ -10,7 +10,6 @@ use super::scan::{Event, Scanner};
 use super::schema::{self, ErrorMsg, LifecycleMsg, LogMsg, StateMsg, TotalsMsg};
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// One record of a recording, as the reader meets them.
@@ -104,7 +103,7 @@ pub fn read_items(
     };
     let mut file = File::open(path).map_err(io)?;
     let mut magic = [0u8; 8];
-    let got = read_full(&mut file, &mut magic).map_err(io)?;
+    let got = super::scan::read_some(&mut file, &mut magic).map_err(io)?;
     if got < magic.len() || magic != *mcap::MAGIC {
         return Err(RecordingError::NotMcap {
             path: path.to_path_buf(),
@@ -217,17 +216,6 @@ pub fn read_items(
         end.truncated = scanner.truncated().map(str::to_string);
     }
     Ok(end)
-}
-
-fn read_full(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut got = 0;
-    while got < buf.len() {
-        match file.read(&mut buf[got..])? {
-            0 => break,
-            n => got += n,
-        }
-    }
-    Ok(got)
 }
 
 /// Decodes a JSON message of `topic`, naming the topic on failure.

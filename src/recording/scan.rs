@@ -334,7 +334,8 @@ fn opcode_known(opcode: u8) -> bool {
     (op::HEADER..=op::DATA_END).contains(&opcode)
 }
 
-fn read_some(file: &mut BufReader<File>, buf: &mut [u8]) -> std::io::Result<usize> {
+/// Reads until `buf` is full or the file ends; the bytes read.
+pub(super) fn read_some(file: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut got = 0;
     while got < buf.len() {
         match file.read(&mut buf[got..])? {
