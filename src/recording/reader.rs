@@ -146,18 +146,7 @@ pub fn read_items(
                         Flow::Continue
                     }
                     mcap::records::Record::Channel(c) => {
-                        let (name, enc, text) = schemas
-                            .get(&c.schema_id)
-                            .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
-                            .unwrap_or(("", "", &[]));
-                        let flow = visit(Item::Channel {
-                            id: c.id,
-                            topic: &c.topic,
-                            schema: name,
-                            schema_encoding: enc,
-                            schema_data: text,
-                            message_encoding: &c.message_encoding,
-                        })?;
+                        let flow = visit(channel_item(&schemas, &c))?;
                         channels.insert(c.id, c.topic);
                         flow
                     }
@@ -179,18 +168,7 @@ pub fn read_items(
                             .remove(&header.channel_id)
                             .filter(|c| !channels.contains_key(&c.id));
                         if let Some(c) = lost {
-                            let (name, enc, text) = schemas
-                                .get(&c.schema_id)
-                                .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
-                                .unwrap_or(("", "", &[]));
-                            visit(Item::Channel {
-                                id: c.id,
-                                topic: &c.topic,
-                                schema: name,
-                                schema_encoding: enc,
-                                schema_data: text,
-                                message_encoding: &c.message_encoding,
-                            })?;
+                            visit(channel_item(&schemas, &c))?;
                             channels.insert(c.id, c.topic);
                         }
                         let topic = channels.get(&header.channel_id).map_or("", String::as_str);
@@ -626,4 +604,23 @@ pub fn state_at(path: &Path, step: u64) -> Result<Option<StateMsg>, RecordingErr
         })
     })?;
     Ok(found)
+}
+
+/// A channel as readers see it, with its schema (empty when the schema was lost).
+fn channel_item<'a>(
+    schemas: &'a BTreeMap<u16, (String, String, Vec<u8>)>,
+    c: &'a mcap::records::Channel,
+) -> Item<'a> {
+    let (schema, schema_encoding, schema_data) = schemas
+        .get(&c.schema_id)
+        .map(|(n, e, t)| (n.as_str(), e.as_str(), t.as_slice()))
+        .unwrap_or(("", "", &[]));
+    Item::Channel {
+        id: c.id,
+        topic: &c.topic,
+        schema,
+        schema_encoding,
+        schema_data,
+        message_encoding: &c.message_encoding,
+    }
 }
