@@ -109,10 +109,18 @@ fn an_array_grown_without_end_stops_at_the_array_limit() {
     let e = hostile(
         "grow_array",
         "    let a = [];\n    loop { a.push(1); }",
-        &ScriptOptions::default(),
+        &limits(|l| l.max_array_size = 1000),
         &["--max-array"],
     );
     assert!(e.message.contains("array"), "{e}");
+    // At the default limits the walks after each push, charged as operations, reach --max-ops
+    // before the array reaches its limit: either way the call stops after bounded work.
+    hostile(
+        "grow_array",
+        "    let a = [];\n    loop { a.push(1); }",
+        &ScriptOptions::default(),
+        &["--max-array", "--max-ops"],
+    );
 }
 
 #[test]
@@ -154,10 +162,52 @@ fn a_map_merged_into_without_end_stops_at_the_map_limit() {
     let e = hostile(
         "mixin_map",
         "    let m = #{};\n    let i = 0;\n    loop { let one = #{}; one[`k${i}`] = i; m.mixin(one); i += 1; }",
-        &ScriptOptions::default(),
+        &limits(|l| l.max_map_size = 1000),
         &["--max-map"],
     );
     assert!(e.message.contains("map"), "{e}");
+}
+
+/// A loop of method calls on an array held at the array limit: rhai walks the whole array after
+/// each call, so the walk is charged as operations. Uncharged, these 10,000 loops are about
+/// 20,000 operations and pass; charged (10,000 items walked per call), they pass `--max-ops`
+/// after a few hundred loops, so the call's time stays bounded by the count.
+#[test]
+fn method_calls_on_a_full_array_are_charged_for_the_walk() {
+    let limit = ScriptOptions::default().limits.max_array_size;
+    let e = hostile(
+        "walk_array",
+        &format!("    let a = [];\n    a.pad({limit}, 0);\n    for i in 0..10000 {{ a.len(); }}"),
+        &ScriptOptions::default(),
+        &["--max-ops"],
+    );
+    assert!(e.message.contains("operations in one call"), "{e}");
+}
+
+/// The charge is for the items walked, not for the calls: 1,000 calls on a 3-item array stay
+/// inside a budget of 10,000 operations that the same calls on a 1,000-item array pass.
+#[test]
+fn the_charge_grows_with_the_items_walked() {
+    let body = |n: usize| {
+        format!("fn update(me, dt) {{\n    let a = [];\n    a.pad({n}, 0);\n    for i in 0..1000 {{ a.len(); }}\n}}\n")
+    };
+    let options = limits(|l| l.max_operations = 10_000);
+    let small = Sandbox::new("walk_small");
+    small.kind("walk_small", &body(3));
+    runs(&scene_of(&small, "walk_small", 1), &options, 3);
+    let large = Sandbox::new("walk_large");
+    large.kind("walk_large", &body(1000));
+    let failure = fail(
+        &scene_of(&large, "walk_large", 1),
+        &options,
+        "walk_large",
+        3,
+    );
+    assert!(
+        failure.err.message.contains("more than 10000 operations"),
+        "{}",
+        failure.err
+    );
 }
 
 #[test]

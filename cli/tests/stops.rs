@@ -1,6 +1,6 @@
-//! Every stop leaves a finished file: a run ended by SIGINT, SIGTERM or SIGHUP finishes its
-//! recording and names the signal, and a scene that cannot be built is recorded with its
-//! scripts and its error.
+//! Every stop leaves a finished file: a run ended by SIGINT, SIGTERM or SIGHUP (while stepping
+//! or while its scene is built) finishes its recording and names the signal, and a scene that
+//! cannot be built is recorded with its scripts and its error.
 
 mod common;
 use common::{critterbox_in, text};
@@ -88,6 +88,52 @@ fn sighup_finishes_the_file_and_exits_129() {
 #[test]
 fn sigint_finishes_the_file_and_exits_130() {
     interrupt_with("INT", 2);
+}
+
+/// A signal while the scene is still being built: the set-up ends, no step is taken, and the
+/// file is finished as interrupted at step 0, with the scene's script attached.
+#[test]
+fn a_signal_during_the_set_up_stops_before_the_first_step_with_a_finished_file() {
+    let dir = tmp("setup-signal");
+    let file = dir.join("run.mcap");
+    let scene = Path::new(common::ROOT).join("tests/scenes/slow_setup.rhai");
+    let child = Command::new(env!("CARGO_BIN_EXE_critterbox"))
+        .args(["run", scene.to_str().expect("utf-8 path")])
+        .args(["--max-ops", "100000000", "--max-step-ops", "0"])
+        .args(["--record", file.to_str().expect("utf-8 path")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // The set-up's loop runs for seconds; the signals are watched from the run's start.
+    std::thread::sleep(Duration::from_millis(400));
+    assert_eq!(
+        std::fs::metadata(&file).ok().map(|m| m.len()),
+        None,
+        "still building the scene: no file yet"
+    );
+    let sent = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+    let o = child.wait_with_output().expect("wait");
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(128 + 15), "{out}");
+    assert!(out.contains("ended: interrupted (SIGTERM)"), "{out}");
+    let rec = Recording::open(&file).expect("open");
+    assert_eq!(rec.truncated, None, "the file is finished");
+    let end = rec.end.clone().expect("end record");
+    assert_eq!(
+        (end.outcome.as_str(), end.reason.as_str(), end.steps),
+        ("interrupted", "SIGTERM", 0)
+    );
+    assert!(
+        rec.scripts
+            .iter()
+            .any(|(path, _)| path.ends_with("slow_setup.rhai")),
+        "the scene's script is attached"
+    );
 }
 
 /// A folder with `scripts/scenes/scene.rhai` holding `scene` and `scripts/kinds/NAME.rhai` for

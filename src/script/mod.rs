@@ -47,7 +47,8 @@ pub struct Limits {
     /// Longest string.
     pub max_string_size: usize,
     /// Longest array (items of nested arrays count too). rhai measures an array after each
-    /// operation that may change it, so this also bounds the work of one operation.
+    /// operation that may change it; that walk is charged as operations
+    /// ([`DATA_WALK_ITEMS_PER_OP`]).
     pub max_array_size: usize,
     /// Largest map (entries of nested maps count too).
     pub max_map_size: usize,
@@ -68,6 +69,12 @@ impl Default for Limits {
         }
     }
 }
+
+/// Items of arrays and maps rhai walks, when it measures them against `--max-array` and
+/// `--max-map`, per operation charged toward `--max-ops` and `--max-step-ops`: about what one
+/// cheap operation costs in time, so the operation limits bound a call's time even when every
+/// operation measures a full array (`vendor/rhai/PATCH.md`).
+pub const DATA_WALK_ITEMS_PER_OP: u64 = 32;
 
 /// Where scripts live and how they are limited.
 #[derive(Clone, Debug, Default)]

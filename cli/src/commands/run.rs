@@ -94,6 +94,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             "--dt {dt}: the time step must be a finite number greater than zero"
         );
     }
+    // Signals are watched from here on, so that one arriving while the scene is built stops
+    // the run before its first step, with a finished file (a second one ends the process).
+    record::watch_signals();
     let mut scene = match load(args) {
         Ok(scene) => scene,
         Err(Unloaded::Usage(e)) => return Err(e),
@@ -122,9 +125,6 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let momentum0 = scene.world.momentum();
     let mut viewer = super::view::Viewer::open(&args.view, &scene.world)?;
     // Recording: started before the first step, fed after each one, closed at the end.
-    // Watched from the file's creation on (a signal during the set-up ends the process as
-    // usual: there is no run to finish yet), so a file that exists is finished by a signal.
-    record::watch_signals();
     let mut recorder = record::start(args, &scene, steps)?;
     let mut interrupted = None;
     let bar = progress_bar(steps);

@@ -94,7 +94,8 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     engine.set_max_array_size(limits.max_array_size);
     engine.set_max_map_size(limits.max_map_size);
     engine.set_fail_on_invalid_map_property(true);
-    step_ops::install(&mut engine, host, limits.max_step_operations);
+    let charged = engine.set_data_walk_charge(super::DATA_WALK_ITEMS_PER_OP);
+    step_ops::install(&mut engine, host, limits.max_step_operations, charged);
 
     rules::register(&mut engine, host);
     vec::register(&mut engine, host);

@@ -8,6 +8,8 @@ use crate::script::host::{with_env, Host};
 use rhai::{Dynamic, Engine, EvalAltResult};
 use std::cell::Cell;
 use std::rc::Rc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// The operations counted for the current step.
 struct StepOps {
@@ -15,35 +17,39 @@ struct StepOps {
     max: u64,
     /// The step being counted (`None` before a world exists).
     step: Cell<Option<u64>>,
-    /// Operations of the step's calls before the running one.
+    /// Operations of the step's calls so far, charges for data walks included.
     spent: Cell<u64>,
-    /// The running call's count at its latest operation.
-    last: Cell<u64>,
+    /// The engine's total of operations charged for data walks, when last seen.
+    charged: Cell<u64>,
 }
 
 impl StepOps {
-    /// Counts operation `ops` of the running call; the error's text once the step is over budget.
-    /// rhai counts each call from 1 and calls this at every operation, so a count of 1 starts a
-    /// call, and any other jump resumes a caller after a call nested in it (a spawn's `init`):
-    /// the step's total is then `spent + ops` exactly.
-    fn count(&self, ops: u64, step_now: impl FnOnce() -> Option<u64>) -> Option<String> {
-        let last = self.last.replace(ops);
+    /// Counts one operation of the running call, whose count is now `ops`, while the engine has
+    /// charged `charged` operations for data walks in all; the error's text once the step is
+    /// over budget. rhai calls this at every operation of every call, nested ones included, so
+    /// the step's total is one per call of this plus the charges; a call's first operation
+    /// (`ops` 1) is where a new step is noticed.
+    fn count(
+        &self,
+        ops: u64,
+        charged: u64,
+        step_now: impl FnOnce() -> Option<u64>,
+    ) -> Option<String> {
         if ops == 1 {
             let step = step_now();
             if step.is_some() && step != self.step.get() {
                 self.step.set(step);
                 self.spent.set(0);
-            } else {
-                // The previous call's operations, or the caller's so far when this one nests.
-                self.spent.set(self.spent.get().saturating_add(last));
             }
-        } else if ops != last.wrapping_add(1) {
-            // A caller resumes: add the nested call's operations, less the caller's own, which
-            // were added when the nested call began and which `ops` counts again.
-            let spent = self.spent.get().saturating_add(last);
-            self.spent.set(spent.saturating_sub(ops - 1));
         }
-        if self.spent.get().saturating_add(ops) <= self.max {
+        let new_charges = charged.wrapping_sub(self.charged.replace(charged));
+        let spent = self
+            .spent
+            .get()
+            .saturating_add(1)
+            .saturating_add(new_charges);
+        self.spent.set(spent);
+        if spent <= self.max {
             return None;
         }
         let step = self
@@ -59,8 +65,10 @@ impl StepOps {
     }
 }
 
-/// Installs the budget of `max` operations per step on `engine` (none when `max` is 0).
-pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64) {
+/// Installs the budget of `max` operations per step on `engine` (none when `max` is 0);
+/// `charged` is the engine's total of operations charged for data walks
+/// (`Engine::set_data_walk_charge`).
+pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64, charged: Arc<AtomicU64>) {
     if max == 0 {
         return;
     }
@@ -68,12 +76,13 @@ pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64) {
         max,
         step: Cell::new(None),
         spent: Cell::new(0),
-        last: Cell::new(0),
+        charged: Cell::new(0),
     };
     let h = host.clone();
     engine.on_progress(move |n| {
         let step_now = || with_env!(h, env => Ok::<_, Box<EvalAltResult>>(env.step_count())).ok();
-        ops.count(n, step_now).map(Dynamic::from)
+        ops.count(n, charged.load(Ordering::Relaxed), step_now)
+            .map(Dynamic::from)
     });
 }
 
@@ -86,7 +95,7 @@ mod tests {
             max,
             step: Cell::new(None),
             spent: Cell::new(0),
-            last: Cell::new(0),
+            charged: Cell::new(0),
         }
     }
 
@@ -94,7 +103,7 @@ mod tests {
     fn run(b: &StepOps, step: u64, calls: &[u64]) -> Option<(usize, u64)> {
         for (i, &len) in calls.iter().enumerate() {
             for n in 1..=len {
-                if b.count(n, || Some(step)).is_some() {
+                if b.count(n, 0, || Some(step)).is_some() {
                     return Some((i, n));
                 }
             }
@@ -115,15 +124,15 @@ mod tests {
         let step = || Some(0);
         // The caller runs 300, a nested call 200, the caller 100 more: 600 in all.
         for n in 1..=300 {
-            assert!(b.count(n, step).is_none());
+            assert!(b.count(n, 0, step).is_none());
         }
         for n in 1..=200 {
-            assert!(b.count(n, step).is_none());
+            assert!(b.count(n, 0, step).is_none());
         }
         for n in 301..=400 {
-            assert!(b.count(n, step).is_none());
+            assert!(b.count(n, 0, step).is_none());
         }
-        assert_eq!(b.spent.get() + b.last.get(), 600);
+        assert_eq!(b.spent.get(), 600);
         // So 400 more fit, and the 401st does not.
         assert_eq!(run(&b, 0, &[400, 1]), Some((1, 1)));
     }
@@ -140,12 +149,30 @@ mod tests {
     fn the_error_names_the_step_the_budget_and_the_flag() {
         let b = budget(10);
         let text = (1..=11)
-            .find_map(|n| b.count(n, || Some(7)))
+            .find_map(|n| b.count(n, 0, || Some(7)))
             .expect("over budget");
         assert!(
             text.contains("step 7") && text.contains("10 operations"),
             "{text}"
         );
         assert!(text.contains("--max-step-ops"), "{text}");
+    }
+
+    #[test]
+    fn operations_charged_for_data_walks_count_toward_the_step() {
+        let b = budget(1000);
+        let step = || Some(0);
+        // One operation, then one more while the engine charged 500 for walking an array.
+        assert!(b.count(1, 0, step).is_none());
+        assert!(b.count(502, 500, step).is_none());
+        assert_eq!(b.spent.get(), 502);
+        // A later call in the same step: 498 operations fit, the 499th does not.
+        assert_eq!(run_charged(&b, 500, 499), Some(499));
+    }
+
+    /// Runs one call of `len` operations with the engine's charge total at `charged`; the
+    /// operation where it stopped.
+    fn run_charged(b: &StepOps, charged: u64, len: u64) -> Option<u64> {
+        (1..=len).find(|&n| b.count(n, charged, || Some(0)).is_some())
     }
 }
