@@ -141,12 +141,13 @@ impl<V: Vector> CritterSet<V> {
     /// Makes room for `additional` more critters than there are slots now, exactly: a scene that
     /// knows how many it will spawn does not leave the slots' doubling growth unused (at a
     /// million critters up to 64 MB).
-    pub fn reserve(&mut self, additional: usize) {
-        self.slots.reserve_exact(additional);
-        self.generations.reserve_exact(additional);
+    pub fn reserve(&mut self, additional: usize) -> Result<(), std::collections::TryReserveError> {
+        self.slots.try_reserve_exact(additional)?;
+        self.generations.try_reserve_exact(additional)?;
         if !self.place.is_empty() {
-            self.place.reserve_exact(additional);
+            self.place.try_reserve_exact(additional)?;
         }
+        Ok(())
     }
 
     /// The slot of critter `id`, if it is there.

@@ -122,6 +122,20 @@ fn bad_numbers_are_clear_errors_not_panics() {
     assert_eq!(o.status.code(), Some(2), "usage errors exit 2");
 }
 
+/// More critters than memory holds (2^32 of them, about 300 GB) is an error naming the count,
+/// not an allocation failure that aborts the process.
+#[test]
+fn more_critters_than_memory_holds_is_an_error_not_an_abort() {
+    let o = critterbox(&["run", "gas", "-n", "4294967296", "--no-record"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("4294967296") && err.contains("memory"),
+        "{err}"
+    );
+    assert!(!err.contains("allocation"), "{err}");
+}
+
 #[test]
 fn same_seed_same_hash_other_seed_other_hash() {
     let hash = |seed: &str| {

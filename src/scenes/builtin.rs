@@ -202,7 +202,7 @@ pub fn gas_with<V: Vector>(
             }
         }
     }
-    world.reserve(p.n);
+    world.reserve(p.n)?;
     for i in 0..p.n {
         let mut pos = V::zero();
         let mut rest = i;

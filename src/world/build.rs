@@ -93,9 +93,21 @@ impl<V: Vector> World<V> {
     }
 
     /// Makes room for `additional` more critters, exactly (for a scene that knows how many it
-    /// will spawn: the critters' storage then does not grow by doubling).
-    pub fn reserve(&mut self, additional: usize) {
-        self.state.critters.reserve(additional);
+    /// will spawn: the critters' storage then does not grow by doubling). An error when there
+    /// is not memory for them.
+    pub fn reserve(&mut self, additional: usize) -> Result<(), Error> {
+        let per_critter = std::mem::size_of::<Option<Critter<V>>>() + std::mem::size_of::<u32>();
+        self.state
+            .critters
+            .reserve(additional)
+            .map_err(|_| Error::InvalidWorld {
+                field: "critters",
+                value: additional.to_string(),
+                reason: format!(
+                    "there is not memory for that many (about {:.3e} bytes for the critters alone); ask for fewer",
+                    additional as f64 * per_critter as f64
+                ),
+            })
     }
 
     /// Spawns a critter now. Errors name the critter and the bad field; nothing is added then.
