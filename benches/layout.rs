@@ -54,7 +54,7 @@ fn build(n: usize, shuffled: bool) -> World<DVec2> {
         let j = (rng.next_u64() % (i as u64 + 1)) as usize;
         disks.swap(i, j);
     }
-    world.reserve(disks.len());
+    world.reserve(disks.len()).expect("memory for the disks");
     for spec in disks {
         world.spawn(spec).expect("a disk");
     }
