@@ -114,6 +114,10 @@ pub const MIXED_3D: &[Mixed] = &[
     },
 ];
 
+/// A mixed scene's world and the ids of its two groups of critters (which they are, each
+/// scene's `*_world` says).
+pub type Groups<V> = (World<V>, Vec<CritterId>, Vec<CritterId>);
+
 const DT: f64 = 1.0 / 60.0;
 const GRAVITY: f64 = 9.81;
 /// Walls' thickness.
@@ -261,9 +265,7 @@ pub fn pile_beside_cradle<V: Vector>(method: Method) -> Result<Vec<f64>, Error> 
 }
 
 /// The world of [`pile_beside_cradle`]: it, the cradle's ids (striker first) and the pile's.
-pub fn pile_beside_cradle_world<V: Vector>(
-    method: Method,
-) -> Result<(World<V>, Vec<CritterId>, Vec<CritterId>), Error> {
+pub fn pile_beside_cradle_world<V: Vector>(method: Method) -> Result<Groups<V>, Error> {
     // 2D: 9 disks of radius 0.5 a row in a well 10 wide; 3D: 4 x 4 spheres of radius 0.45 a
     // layer in a well 4 x 4. Either leaves room to shake them.
     let (width, per_row, r) = if V::DIM == 2 {
@@ -388,9 +390,7 @@ fn inside_box<V: Vector>(p: V, inner: V) -> bool {
 }
 
 /// The world of [`bullets_into_pile`]: it, the bullets' ids and the pile's.
-pub fn bullets_into_pile_world<V: Vector>(
-    method: Method,
-) -> Result<(World<V>, Vec<CritterId>, Vec<CritterId>), Error> {
+pub fn bullets_into_pile_world<V: Vector>(method: Method) -> Result<Groups<V>, Error> {
     let inner = bullet_box::<V>();
     let width = inner.get(0);
     let mut w = walled_box(method, inner, inner + V::splat(1.0), true)?;
@@ -506,9 +506,7 @@ fn near_the_pile<V: Vector>(w: &World<V>, gas: &[CritterId], pile: &[CritterId])
 }
 
 /// The world of [`gas_above_pile`]: it, the gas's ids and the pile's.
-pub fn gas_above_pile_world<V: Vector>(
-    method: Method,
-) -> Result<(World<V>, Vec<CritterId>, Vec<CritterId>), Error> {
+pub fn gas_above_pile_world<V: Vector>(method: Method) -> Result<Groups<V>, Error> {
     let width = if V::DIM == 2 { 10.0 } else { 4.0 };
     let mut inner = V::splat(width);
     inner.set(1, 20.0);
