@@ -337,7 +337,7 @@ pub fn cradle_error<V: Vector>(w: &World<V>, cradle: &[CritterId], v0: f64) -> f
     }
 }
 
-/// Layers of the resting piles (bullets, gas).
+/// Layers of the bullets' pile.
 const BULLET_PILE_LAYERS: usize = 6;
 /// The bullets' speed: 1.67 per step, over three times what carries a bullet past the middle
 /// of a wall (0.15) or through a ball (0.55) in one step.
@@ -396,8 +396,8 @@ pub fn bullets_into_pile_world<V: Vector>(method: Method) -> Result<Groups<V>, E
     let mut w = walled_box(method, inner, inner + V::splat(1.0), true)?;
     let pile = jammed_pile(&mut w, width as usize, BULLET_PILE_LAYERS, 0.5)?;
     let mut bullets = Vec::new();
-    // Four bullets 2 above the pile, spread across the box, each slanting towards the nearer
-    // side wall (and, in 3D, the nearer of the walls across z).
+    // Four bullets at height 8, about 3 above the pile, spread across the box, each slanting
+    // towards the nearer side wall (and, in 3D, the nearer of the walls across z).
     for k in 0..4 {
         let x = width * (k as f64 + 0.5) / 4.0;
         let z = width * if k % 2 == 0 { 0.3 } else { 0.7 };
