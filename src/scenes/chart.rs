@@ -1,7 +1,9 @@
 //! The sweep behind `critterbox chart`: each method's cost against its error over a range of
 //! time steps, on a gas (error against the exact run) and on the deep pile of [`super::stress`]
-//! (error the deepest overlap).
+//! (error the deepest overlap); and each method's cost per step against each part's error on the
+//! mixed scenes of [`super::mixed`].
 
+use super::mixed::MIXED;
 use super::stress::{max_overlap, pile, DEEP_PILE_ROWS};
 use super::{gas, GasParams};
 use crate::critter::CritterId;
@@ -97,6 +99,43 @@ fn dt_sweep(
                 cost,
                 error: error(&w),
             });
+        }
+    }
+    Ok(out)
+}
+
+/// One point of the chart's mixed panel: a method's cost on a mixed scene and one part's error.
+#[derive(Clone, Debug)]
+pub struct MixedPoint {
+    /// The method.
+    pub method: Method,
+    /// The scene's name.
+    pub scene: &'static str,
+    /// The part's name.
+    pub part: &'static str,
+    /// Wall time per step of the whole scene (seconds).
+    pub cost: f64,
+    /// The part's error (its own measure: [`super::mixed::Part`]).
+    pub error: f64,
+}
+
+/// Runs each 2D mixed scene once under each method: a point per part.
+pub fn chart_mixed_points(methods: &[Method]) -> Result<Vec<MixedPoint>, Error> {
+    let mut out = Vec::new();
+    for &method in methods {
+        for scene in MIXED {
+            let start = std::time::Instant::now();
+            let errors = (scene.run)(method)?;
+            let cost = start.elapsed().as_secs_f64() / scene.steps as f64;
+            for (part, error) in scene.parts.iter().zip(errors) {
+                out.push(MixedPoint {
+                    method,
+                    scene: scene.name,
+                    part: part.name,
+                    cost,
+                    error,
+                });
+            }
         }
     }
     Ok(out)

@@ -1,11 +1,16 @@
 //! Scenes: a world ready to run and what a scene adds around it ([`Scene`], [`AnyWorld`]), the
 //! built-in scenes (`critterbox run NAME`, and the standard gas the benchmarks measure), and,
-//! for the tests and `critterbox stability`/`chart`, the stress scenes (`stress`) and the
-//! chart's sweep (`chart`). Each scene is written once.
+//! for the tests and `critterbox stability`/`chart`, the stress scenes (`stress`), the mixed
+//! scenes (`mixed`), the readings of where `solve:n` fails (`solve_limits`) and the chart's
+//! sweeps (`chart`). Each scene is written once.
 
 mod builtin;
 #[doc(hidden)]
 pub mod chart;
+#[doc(hidden)]
+pub mod mixed;
+#[doc(hidden)]
+pub mod solve_limits;
 #[doc(hidden)]
 pub mod stress;
 

@@ -1,12 +1,15 @@
 //! `critterbox chart`: cost against error for every method over a sweep of dt on two scenes (a
 //! gas, where the error is the position error against the exact run, and a deep pile under
-//! gravity, where it is the deepest overlap), written as `docs/speed-vs-accuracy.svg` and `.png`
-//! (see the README for how to read it). Text is laid out
+//! gravity, where it is the deepest overlap), and cost per step against each part's error on the
+//! 2D mixed scenes (a point per method and part, labelled with the part), written as
+//! `docs/speed-vs-accuracy.svg` and `.png` (see the README for how to read it). Text is laid out
 //! with a TrueType font (`--font`), for both files.
 
 use anyhow::Context;
 use clap::Args;
-use critterbox::scenes::chart::{chart_pile_points, chart_points, ChartPoint};
+use critterbox::scenes::chart::{
+    chart_mixed_points, chart_pile_points, chart_points, ChartPoint, MixedPoint,
+};
 use critterbox::scenes::stress::METHODS;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -37,13 +40,50 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(148, 103, 189), // auto: purple
 ];
 
-/// One panel of the chart: its points, title, error axis and where its legend is out of the way.
+/// One panel of the chart: its points, title, axes and where its legend is out of the way; a
+/// sweep's points are joined per method, a mixed panel's are labelled each with its part.
 struct Panel {
     points: Vec<ChartPoint>,
     title: &'static str,
     error: &'static str,
+    cost: &'static str,
+    labels: Vec<&'static str>,
     legend: SeriesLabelPosition,
 }
+
+/// A short label for a mixed scene's part on the chart.
+fn part_label(p: &MixedPoint) -> &'static str {
+    match (p.scene, p.part) {
+        ("gas above pile", "pile") => "gas's pile",
+        ("bullets into pile", "escaped") => "bullets out",
+        (_, part) => part,
+    }
+}
+
+/// The mixed panel: a point per method and part, labelled with the part.
+fn mixed_panel(points: Vec<MixedPoint>) -> Panel {
+    let labels = points.iter().map(part_label).collect();
+    let points = points
+        .into_iter()
+        .map(|p| ChartPoint {
+            method: p.method,
+            dt: 1.0 / 60.0,
+            cost: p.cost,
+            error: p.error,
+        })
+        .collect();
+    Panel {
+        points,
+        title: "mixed scenes, dt 1/60, a point per part",
+        error: "each part's error (its own measure, docs/stability.md)",
+        cost: "wall s per step",
+        labels,
+        legend: SeriesLabelPosition::MiddleMiddle,
+    }
+}
+
+/// The sweeps' cost axis.
+const SWEEP_COST: &str = "wall s per simulated s per critter";
 
 /// Runs the command.
 pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
@@ -52,29 +92,36 @@ pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             points: chart_points(&METHODS)?,
             title: "100-disk gas, 1 s, dt 1/15 to 1/960",
             error: "RMS position error against the exact event-driven run (radii)",
+            cost: SWEEP_COST,
+            labels: Vec::new(),
             legend: SeriesLabelPosition::UpperMiddle,
         },
         Panel {
             points: chart_pile_points(&METHODS)?,
             title: "20-row pile under gravity, 2 s, dt 1/15 to 1/240",
             error: "deepest overlap at the end (radii)",
+            cost: SWEEP_COST,
+            labels: Vec::new(),
             legend: SeriesLabelPosition::UpperLeft,
         },
+        mixed_panel(chart_mixed_points(&METHODS)?),
     ];
     for panel in &panels {
         writeln!(out, "{}: {}", panel.title, panel.error)?;
         writeln!(
             out,
-            "method      dt          cost (s per sim s per critter)  error (radii)"
+            "method      dt          cost ({})  error  part",
+            panel.cost
         )?;
-        for p in &panel.points {
+        for (i, p) in panel.points.iter().enumerate() {
             writeln!(
                 out,
-                "{:<11} {:<11.3e} {:<31.3e} {:.3e}",
+                "{:<11} {:<11.3e} {:<11.3e} {:.3e}  {}",
                 p.method.to_string(),
                 p.dt,
                 p.cost,
-                p.error
+                p.error,
+                panel.labels.get(i).copied().unwrap_or("")
             )?;
         }
     }
@@ -90,12 +137,12 @@ pub fn run(args: &ChartArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, font)
         .map_err(|_| anyhow::anyhow!("{}: not a usable TrueType font", args.font.display()))?;
     draw(
-        SVGBackend::new(&svg, (1600, 600)).into_drawing_area(),
+        SVGBackend::new(&svg, (2400, 600)).into_drawing_area(),
         &panels,
     )
     .map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
     draw(
-        BitMapBackend::new(&png, (1600, 600)).into_drawing_area(),
+        BitMapBackend::new(&png, (2400, 600)).into_drawing_area(),
         &panels,
     )
     .map_err(|e| anyhow::anyhow!("{}: {e}", png.display()))?;
@@ -151,7 +198,7 @@ where
     chart
         .configure_mesh()
         .x_desc(panel.error)
-        .y_desc("wall s per simulated s per critter")
+        .y_desc(panel.cost)
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
@@ -162,13 +209,29 @@ where
             .filter(|p| p.method == *m)
             .map(|p| (err(p), p.cost))
             .collect();
+        let line = if panel.labels.is_empty() {
+            pts.clone()
+        } else {
+            Vec::new()
+        };
         chart
-            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
+            .draw_series(LineSeries::new(line, color.stroke_width(2)))?
             .label(m.to_string())
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
             });
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+        let labelled = points
+            .iter()
+            .zip(&panel.labels)
+            .filter(|(p, _)| p.method == *m);
+        chart.draw_series(labelled.map(|(p, label)| {
+            Text::new(
+                *label,
+                (err(p), p.cost),
+                ("sans-serif", 11).into_font().color(&color),
+            )
+        }))?;
     }
     chart
         .configure_series_labels()

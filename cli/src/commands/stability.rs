@@ -1,9 +1,11 @@
 //! `critterbox stability`: run the stress scenes under every method and print the table of
-//! `docs/stability.md` (scene x method -> measured error), in 2D and in 3D; with `--bullets`,
-//! the bullet sweep behind the table's first row.
+//! `docs/stability.md` (scene x method -> measured error), in 2D and in 3D, the mixed scenes'
+//! parts last; with `--bullets`, the bullet sweep behind the table's first row; with `--mixed`,
+//! the mixed scenes' rows alone.
 
 use clap::Args;
 use critterbox::method::Method;
+use critterbox::scenes::mixed::{Mixed, MIXED, MIXED_3D};
 use critterbox::scenes::stress::{
     bullet, bullet_3d, bullet_speeds, first_tunnelling_speed, first_tunnelling_speed_3d, Stress,
     METHODS, STRESS, STRESS_3D,
@@ -20,6 +22,9 @@ pub struct StabilityArgs {
     /// the plate (3D) under each method. The tables' bullet row is the first speed that does.
     #[arg(long)]
     pub bullets: bool,
+    /// Print only the mixed scenes' rows (a row per scene and part), 2D then 3D.
+    #[arg(long)]
+    pub mixed: bool,
 }
 
 /// The 2D bullet, as the tables and the sweep name it.
@@ -34,9 +39,46 @@ pub fn run(args: &StabilityArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         writeln!(out)?;
         return bullet_sweep(out, BULLET_3D, bullet_3d);
     }
+    if args.mixed {
+        header(out, &["scene", "error"])?;
+        mixed_rows(out, MIXED)?;
+        writeln!(out)?;
+        header(out, &["scene", "error"])?;
+        return mixed_rows(out, MIXED_3D);
+    }
     table(out, BULLET_2D, first_tunnelling_speed, STRESS)?;
+    mixed_rows(out, MIXED)?;
     writeln!(out)?;
-    table(out, BULLET_3D, first_tunnelling_speed_3d, STRESS_3D)
+    table(out, BULLET_3D, first_tunnelling_speed_3d, STRESS_3D)?;
+    mixed_rows(out, MIXED_3D)
+}
+
+/// A row per part of each mixed scene: each method runs the scene once and measures every
+/// part (the milliseconds are the whole run's, the same in each part's row).
+fn mixed_rows(out: &mut dyn Write, scenes: &[Mixed]) -> anyhow::Result<()> {
+    for s in scenes {
+        let mut runs = Vec::new();
+        for m in METHODS {
+            let t = Instant::now();
+            let errors = (s.run)(m)?;
+            runs.push((errors, t.elapsed().as_secs_f64() * 1e3));
+        }
+        for (i, part) in s.parts.iter().enumerate() {
+            let cells: Vec<String> = runs
+                .iter()
+                .map(|(errors, ms)| format!("{:.2e} ({ms:.0} ms)", errors[i]))
+                .collect();
+            writeln!(
+                out,
+                "| {}: {} | {} | {} |",
+                s.name,
+                part.name,
+                part.error,
+                cells.join(" | ")
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// The header of a table with a column per method, after `first` columns.
