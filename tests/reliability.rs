@@ -142,6 +142,45 @@ fn a_hook_spawn_of_an_impossible_radius_is_an_error_though_overlaps_are_pushed()
 }
 
 #[test]
+fn a_live_critter_grown_past_the_box_is_an_error_naming_radius_and_box() {
+    let sandbox = Sandbox::new("live_radius");
+    // Growing in a hook, or between steps in the scene, is held to what a spawn is.
+    sandbox.kind(
+        "swelling",
+        "fn update(me, dt) {\n    if world().step_count == 1 {\n        me.radius = 100.0;\n    }\n}\n",
+    );
+    let mut scene = sandbox.load(
+        "world(#{ dim: 2, size: vec(10, 10) });\n\
+         spawn(\"swelling\", #{ pos: vec(5, 5) });\n",
+    );
+    step(&mut scene);
+    let err = scene.step().expect_err("the radius does not fit");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("radius 100 ") && msg.contains("10 x 10"),
+        "{msg}"
+    );
+    assert!(msg.contains("swelling.rhai:3"), "no file and line: {msg}");
+    let err = sandbox
+        .try_load(
+            "world(#{ dim: 2, size: vec(10, 10) });\n\
+             let b = spawn(\"ball\", #{ pos: vec(5, 5) });\n\
+             b.radius = 1e300;\n",
+        )
+        .err()
+        .expect("the setter fails");
+    let msg = err.to_string();
+    assert!(msg.contains("radius") && msg.contains("too large"), "{msg}");
+    // A radius that fits is set.
+    let mut ok = sandbox.load(
+        "world(#{ dim: 2, size: vec(10, 10) });\n\
+         let b = spawn(\"ball\", #{ pos: vec(5, 5) });\n\
+         b.radius = 4.0;\n",
+    );
+    step(&mut ok);
+}
+
+#[test]
 fn a_wall_through_a_critter_is_an_error_in_either_order() {
     let ball = || CritterSpec::ball(DVec2::new(5.0, 5.0)).radius(0.5);
     let wall = || WallBox::segment(DVec2::new(2.0, 5.2), DVec2::new(8.0, 5.2), 0.2).unwrap();

@@ -5,7 +5,7 @@
 
 use super::state::State;
 use super::{fmt_vec, World};
-use crate::border::Border;
+use crate::border::{Border, Topology};
 use crate::contact::contact_wall_ball;
 use crate::critter::{
     check_positive, check_restitution, Critter, CritterId, CritterSpec, Shape, Traits, CLASS_UNSET,
@@ -468,42 +468,53 @@ fn fmt_sides<V: Vector>(size: V) -> String {
     sides.join(" x ")
 }
 
+/// A radius (finite and positive) within [`MIN_RADIUS`]..=[`MAX_RADIUS`] and whose disk fits in
+/// the world box `topo` when its border bounds it (bounce, clamp): errors name the radius and
+/// the box. For spawns and for a live critter's new radius alike.
+pub(crate) fn check_radius_in_box<V: Vector>(
+    topo: &Topology<V>,
+    who: impl Fn() -> String,
+    radius: f64,
+) -> Result<(), Error> {
+    let bad = |reason: String| Error::InvalidRadius {
+        critter: who(),
+        radius: fmt_number(radius),
+        reason,
+    };
+    if radius > MAX_RADIUS {
+        return Err(bad(format!(
+            "is too large: a radius is at most {MAX_RADIUS:e} (beyond it the mass, density x radius^3, is not a finite number)"
+        )));
+    }
+    if radius < MIN_RADIUS {
+        return Err(bad(format!(
+            "is too small: a radius is at least {MIN_RADIUS:e} (below it the mass, density x radius^3, is zero)"
+        )));
+    }
+    if matches!(topo.border, Border::Bounce | Border::Clamp) {
+        let size = topo.size();
+        let diameter = 2.0 * radius;
+        let side = (0..V::DIM)
+            .map(|a| size.get(a))
+            .fold(f64::INFINITY, f64::min);
+        if diameter > side {
+            return Err(bad(format!(
+                "does not fit in the world box {} (its diameter {} exceeds the side {}): give a radius of at most {}, or make the world larger",
+                fmt_sides(size),
+                fmt_number(diameter),
+                fmt_number(side),
+                fmt_number(0.5 * side)
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl<V: Vector> State<V> {
-    /// A radius (finite and positive) within [`MIN_RADIUS`]..=[`MAX_RADIUS`] and whose disk
-    /// fits in the world box when the border bounds it (bounce, clamp): errors name the radius
-    /// and the box.
+    /// A radius (finite and positive) within [`MIN_RADIUS`]..=[`MAX_RADIUS`] whose disk fits in
+    /// the world box ([`check_radius_in_box`]) and between the walls lining it.
     fn check_radius(&self, who: impl Fn() -> String, radius: f64) -> Result<(), Error> {
-        let bad = |reason: String| Error::InvalidRadius {
-            critter: who(),
-            radius: fmt_number(radius),
-            reason,
-        };
-        if radius > MAX_RADIUS {
-            return Err(bad(format!(
-                "is too large: a radius is at most {MAX_RADIUS:e} (beyond it the mass, density x radius^3, is not a finite number)"
-            )));
-        }
-        if radius < MIN_RADIUS {
-            return Err(bad(format!(
-                "is too small: a radius is at least {MIN_RADIUS:e} (below it the mass, density x radius^3, is zero)"
-            )));
-        }
-        if matches!(self.topo.border, Border::Bounce | Border::Clamp) {
-            let size = self.topo.size();
-            let diameter = 2.0 * radius;
-            let side = (0..V::DIM)
-                .map(|a| size.get(a))
-                .fold(f64::INFINITY, f64::min);
-            if diameter > side {
-                return Err(bad(format!(
-                    "does not fit in the world box {} (its diameter {} exceeds the side {}): give a radius of at most {}, or make the world larger",
-                    fmt_sides(size),
-                    fmt_number(diameter),
-                    fmt_number(side),
-                    fmt_number(0.5 * side)
-                )));
-            }
-        }
+        check_radius_in_box(&self.topo, &who, radius)?;
         self.check_fits_between_walls(who, radius)
     }
 

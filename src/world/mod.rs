@@ -31,7 +31,7 @@ mod step;
 mod tests;
 pub(crate) mod touch;
 
-pub(crate) use build::{OnOverlap, Placed};
+pub(crate) use build::{check_radius_in_box, OnOverlap, Placed};
 pub use config::WorldConfig;
 pub use diagnostics::Diagnostics;
 pub use layout::{Locality, LOCALITY};

@@ -7,6 +7,7 @@ use super::{error, fail, fail_hint, lib_err, Res};
 use crate::critter::CritterId;
 use crate::script::host::{with_env, Host};
 use crate::vector::Vector;
+use crate::world::check_radius_in_box;
 use glam::DVec3;
 use rhai::{Dynamic, Engine, EvalAltResult, INT};
 use std::rc::Rc;
@@ -147,9 +148,25 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     critter_setter!(engine, host, "vel", DVec3, |c, v| set_vec(
         &mut c.vel, v, "vel"
     ));
-    critter_setter!(engine, host, "radius", Dynamic, |c, v| c
-        .set_radius(num_or(&v, "radius")?)
-        .map_err(lib_err));
+    // A new radius must fit in the world box, as a spawn's must.
+    let h = host.clone();
+    engine.register_set("radius", move |r: &mut CritterRef, v: Dynamic| -> Res<()> {
+        let (id, radius) = (r.0, num_or(&v, "radius")?);
+        with_env!(h, env => {
+            if let Some(c) = env.critter(id) {
+                let who = c.describe();
+                check_radius_in_box(env.topology(), || who.clone(), radius).map_err(lib_err)?;
+            }
+            match env.critter_mut(id) {
+                Some(c) => c.set_radius(radius).map_err(lib_err),
+                None => if env.critter(id).is_some() {
+                    fail("critters are read-only in collides_with: radius cannot be set there")
+                } else {
+                    Err(gone(id))
+                },
+            }
+        })
+    });
     critter_setter!(engine, host, "mass", Dynamic, |c, v| c
         .set_mass(num_or(&v, "mass")?)
         .map_err(lib_err));
