@@ -154,8 +154,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         let (id, radius) = (r.0, num_or(&v, "radius")?);
         with_env!(h, env => {
             if let Some(c) = env.critter(id) {
-                let who = c.describe();
-                check_radius_in_box(env.topology(), || who.clone(), radius).map_err(lib_err)?;
+                check_radius_in_box(env.topology(), || c.describe(), radius).map_err(lib_err)?;
             }
             match env.critter_mut(id) {
                 Some(c) => c.set_radius(radius).map_err(lib_err),
