@@ -127,7 +127,7 @@ const BULLET_STEPS: u64 = 60;
 const GAS_STEPS: u64 = 120;
 
 /// A world under gravity (along -y) from -1 on every axis to `top`, with a box of walls
-/// [`WALL`] thick around the inside from the origin to `inner`: a floor, side walls `inner`
+/// `WALL` thick around the inside from the origin to `inner`: a floor, side walls `inner`
 /// high, and a lid when `lid`.
 pub fn walled_box<V: Vector>(
     method: Method,
@@ -252,7 +252,7 @@ const STRIKER: f64 = 5.0;
 
 /// A jumbled pile of [`JUMBLED_PILE`] balls (restitution 0.5) dropped into a well (10 wide, in 3D
 /// 4 x 4) from a loose grid shaken by the world's generator, settling for 4 s, beside a
-/// five-ball Newton's cradle (radius 0.5, elastic) struck at [`STRIKER`] high in the air, far
+/// five-ball Newton's cradle (radius 0.5, elastic) struck at `STRIKER` high in the air, far
 /// from the pile, all of it falling freely. The errors: the cradle's (as the stress cradle
 /// measures it, in the frame that falls with it) and the pile's deepest overlap.
 pub fn pile_beside_cradle<V: Vector>(method: Method) -> Result<Vec<f64>, Error> {
@@ -344,7 +344,7 @@ const BULLET_PILE_LAYERS: usize = 6;
 pub const BULLET_SPEED: f64 = 100.0;
 
 /// A pile resting in a closed box (10 wide and 12 high; in 3D 4 x 12 x 4) that cannot spread
-/// ([`jammed_pile`], 6 layers, restitution 0.5), and four bullets of radius 0.05 fired into it
+/// (`jammed_pile`, 6 layers, restitution 0.5), and four bullets of radius 0.05 fired into it
 /// from above at [`BULLET_SPEED`], slanting towards the walls, for 1 s. The errors: critters
 /// that were outside the box at some step's end (tunnelled through a wall, the floor or the
 /// lid), the largest displacement of a pile ball (radii), and the pile's deepest overlap at the
@@ -418,7 +418,7 @@ pub fn bullets_into_pile_world<V: Vector>(method: Method) -> Result<Groups<V>, E
 /// Layers of the pile under the gas.
 const GAS_PILE_LAYERS: usize = 4;
 
-/// A resting pile ([`jammed_pile`], 4 layers, restitution 0.5) at the bottom of a closed box
+/// A resting pile (`jammed_pile`, 4 layers, restitution 0.5) at the bottom of a closed box
 /// (10 wide and 20 high; in 3D 4 x 20 x 4) and an elastic gas above it: 30 disks of radius 0.25
 /// (in 3D 27 spheres) from 9 up, velocities up to 5 per axis from the world's generator, for
 /// 2 s. The errors: the gas's energy drift ([`GasDrift::drift`]) and the pile's deepest overlap
