@@ -120,6 +120,14 @@ pub enum Why {
         /// Without gravity: the event step, which flies the swept step's events.
         event: bool,
     },
+    /// Event under gravity: no island rests on anything, so every contact is an impact between
+    /// critters in flight (see `method::islands`).
+    Impacts {
+        /// The islands.
+        islands: usize,
+        /// The critters in them.
+        critters: usize,
+    },
 }
 
 impl std::fmt::Display for Why {
@@ -150,6 +158,10 @@ impl std::fmt::Display for Why {
             Why::Calm { fastest, smallest } => write!(
                 f,
                 "event: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete would not tunnel either; without gravity the exact event step, its flight kept from step to step, costs about what the discrete step does"
+            ),
+            Why::Impacts { islands, critters } => write!(
+                f,
+                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, so every contact is an impact between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum)"
             ),
             Why::Fast {
                 fastest,
