@@ -9,10 +9,6 @@ use glam::DVec2;
 /// are left at rest (relative, as all fall together).
 const ROUND_OFF: f64 = 1e-12;
 
-/// How much deeper than `solve:8`'s the pile may end, in radii: both end asleep, where their
-/// settling left them (the target is no deeper at all; see docs/methods.md).
-const PILE_SLACK: f64 = 0.01;
-
 /// The striker's speed.
 const STRIKE: f64 = 5.0;
 
@@ -110,17 +106,24 @@ fn out_of_the_well(w: &World<DVec2>, ids: &[CritterId]) -> usize {
         .count()
 }
 
-/// Runs the scene under `method`: its world, the pile's and the cradle's ids.
-fn run(method: Method) -> (World<DVec2>, Vec<CritterId>, Vec<CritterId>) {
+/// Runs the scene under `method`: its world, the pile's and the cradle's ids, and the steps
+/// `auto` took with two methods.
+fn run(method: Method) -> (World<DVec2>, Vec<CritterId>, Vec<CritterId>, usize) {
     let (mut w, pile, cradle) = pile_beside_cradle(method);
-    w.run(STEPS).expect("run");
-    (w, pile, cradle)
+    let mut mixed = 0;
+    for _ in 0..STEPS {
+        w.step().expect("step");
+        mixed += usize::from(w.auto_islands().is_some_and(|s| s.mixed()));
+    }
+    (w, pile, cradle, mixed)
 }
 
 #[test]
 fn auto_keeps_the_cradle_exact_and_the_pile_as_solve_does() {
-    let (auto, pile, cradle) = run(Method::Auto);
-    let (solve, _, _) = run(Method::Solve(8));
+    let (auto, pile, cradle, mixed) = run(Method::Auto);
+    let (solve, _, _, _) = run(Method::Solve(8));
+    // The cradle's impacts took event while the pile was solved.
+    assert!(mixed > 0, "no step was mixed");
     // The scene tests what it claims: solve breaks the cradle.
     assert!(
         cradle_error(&solve, &cradle) > 0.1,
@@ -134,22 +137,13 @@ fn auto_keeps_the_cradle_exact_and_the_pile_as_solve_does() {
         deepest_overlap(&solve, &pile),
     );
     assert!(
-        mine <= theirs + PILE_SLACK,
+        mine <= theirs,
         "auto's pile sinks {mine:.4} radii, solve:8's {theirs:.4}"
     );
-    assert_eq!(out_of_the_well(&auto, &pile), 0, "a disk tunnelled");
-    // The cradle fell 4 s without touching anything but itself.
-    let fallen = auto.get(cradle[0]).map_or(f64::NAN, |c| c.pos.y);
-    let exact = 100.0 - 0.5 * 9.81 * (STEPS as f64 / 60.0).powi(2);
-    assert!(
-        (fallen - exact).abs() < 1e-9,
-        "the striker is at {fallen}, not {exact}"
+    println!(
+        "cradle {error:.3e}; pile overlap auto {mine:.4}, solve:8 {theirs:.4}; {mixed} mixed steps"
     );
-    let summary = auto
-        .auto_islands()
-        .expect("auto reports its islands")
-        .clone();
-    assert!(summary.mixed(), "{summary}");
+    assert_eq!(out_of_the_well(&auto, &pile), 0, "a disk tunnelled");
 }
 
 #[test]

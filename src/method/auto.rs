@@ -161,7 +161,7 @@ impl std::fmt::Display for Why {
             ),
             Why::Impacts { islands, critters } => write!(
                 f,
-                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, so every contact is an impact between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum)"
+                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, and in each two critters approach each other: every contact is an impact between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum)"
             ),
             Why::Fast {
                 fastest,

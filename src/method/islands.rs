@@ -16,10 +16,11 @@
 //! within reach of a wall, a fixed critter or a bouncing edge and approaches it slower than
 //! [`RESTING_STEPS`] steps of gravity (`|g| dt`): it is held up, and its contacts carry weight,
 //! which is what `solve:N` is for. An island held up by nothing falls freely as a whole: gravity
-//! does not change its disks' relative motion, so its contacts are impacts (a cradle struck in
-//! mid-air, a clump thrown), and only the exact event flight keeps them (a solve spreads a
-//! cradle's momentum over its balls). A disk with nothing within reach is *free*: no method
-//! collides it, so it goes with the cheapest step.
+//! does not change its disks' relative motion, so when two of its disks within reach approach
+//! each other its contacts are *impacts* (a cradle struck in mid-air, a clump thrown), and only
+//! the exact event flight keeps them (a solve spreads a cradle's momentum over its balls).
+//! Otherwise it is *free*: no two of its disks meet in the step (at most one hits a wall), and
+//! it goes with the resting islands' step, which moves it as the plain step does.
 //!
 //! Determinism: the union keeps the lower slot as each root, and islands are listed by their
 //! lowest slot, so the result depends on neither thread count nor the order of the passes.
@@ -37,7 +38,7 @@ pub const RESTING_STEPS: f64 = 2.0;
 /// How an island's contacts behave in the coming step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Regime {
-    /// One disk with nothing within reach: no collision can happen to it.
+    /// Held up by nothing, and no two of its disks approach each other: none meet in the step.
     Free,
     /// Held up by a wall, a fixed critter or an edge: its contacts carry weight.
     Resting,
@@ -49,7 +50,7 @@ impl Regime {
     /// A few words for the island summary.
     pub fn describe(self) -> &'static str {
         match self {
-            Regime::Free => "free flight, nothing within reach",
+            Regime::Free => "in flight, no two meet",
             Regime::Resting => "resting contacts under gravity",
             Regime::Impact => "impacts in flight",
         }
@@ -125,7 +126,8 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
         d.reach = reach(d.vel.length(), g, dt);
     }
     let mut deepest = vec![0.0f64; n];
-    link_pairs(state, &disks, &mut parent, &mut deepest);
+    let mut closing = vec![false; n];
+    link_pairs(state, &disks, &mut parent, &mut deepest, &mut closing);
     loop {
         // The islands' energies and deepest overlaps, gathered at their roots.
         let mut energy = vec![0.0f64; n];
@@ -153,12 +155,20 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
         }
         // Wider reaches may join islands: link again, and stop when none joined.
         let before = count_roots(&mut parent);
-        link_pairs(state, &disks, &mut parent, &mut deepest);
+        link_pairs(state, &disks, &mut parent, &mut deepest, &mut closing);
         if count_roots(&mut parent) == before {
             break;
         }
     }
-    classify(state, &disks, &supports, &mut parent, slots.len(), g * dt)
+    classify(
+        state,
+        &disks,
+        &supports,
+        &closing,
+        &mut parent,
+        slots.len(),
+        g * dt,
+    )
 }
 
 /// How far a disk at speed `u` may move in a step (see the module docs), with a margin for
@@ -174,6 +184,7 @@ fn link_pairs<V: Vector>(
     disks: &[Disk<V>],
     parent: &mut [u32],
     deepest: &mut [f64],
+    closing: &mut [bool],
 ) {
     let n = disks.len();
     if n < 2 {
@@ -237,18 +248,23 @@ fn link_pairs<V: Vector>(
             fill[cell_of[k]] += 1;
         }
     }
-    let test = |a: usize, b: usize, parent: &mut [u32], deepest: &mut [f64]| {
-        let (da, db) = (&disks[a], &disks[b]);
-        let d = topo.delta(da.pos, db.pos).length();
-        let gap = d - da.radius - db.radius;
-        if gap <= da.reach + db.reach {
-            union(parent, a, b);
-            if gap < 0.0 {
-                deepest[a] = deepest[a].max(-gap);
-                deepest[b] = deepest[b].max(-gap);
+    let test =
+        |a: usize, b: usize, parent: &mut [u32], deepest: &mut [f64], closing: &mut [bool]| {
+            let (da, db) = (&disks[a], &disks[b]);
+            let offset = topo.delta(da.pos, db.pos);
+            let gap = offset.length() - da.radius - db.radius;
+            if gap <= da.reach + db.reach {
+                union(parent, a, b);
+                if (db.vel - da.vel).dot(offset) < 0.0 {
+                    closing[a] = true;
+                    closing[b] = true;
+                }
+                if gap < 0.0 {
+                    deepest[a] = deepest[a].max(-gap);
+                    deepest[b] = deepest[b].max(-gap);
+                }
             }
-        }
-    };
+        };
     let wraps = topo.wraps();
     for a in 0..n {
         if is_wide(a) {
@@ -289,7 +305,7 @@ fn link_pairs<V: Vector>(
                     seen.push(k);
                     for &b in &order[start[k]..start[k + 1]] {
                         if b > a {
-                            test(a, b, parent, deepest);
+                            test(a, b, parent, deepest, closing);
                         }
                     }
                 }
@@ -299,7 +315,7 @@ fn link_pairs<V: Vector>(
     for &a in &wide {
         for b in 0..n {
             if b != a && (!is_wide(b) || b > a) {
-                test(a, b, parent, deepest);
+                test(a, b, parent, deepest, closing);
             }
         }
     }
@@ -310,6 +326,7 @@ fn classify<V: Vector>(
     state: &State<V>,
     disks: &[Disk<V>],
     supports: &[Support<'_, V>],
+    closing: &[bool],
     parent: &mut [u32],
     slot_count: usize,
     g_dt: f64,
@@ -317,15 +334,14 @@ fn classify<V: Vector>(
     let n = disks.len();
     let topo = &state.topo;
     let mut size = vec![0usize; n];
-    let mut near = vec![false; n];
+    let mut meets = vec![false; n];
     let mut held = vec![false; n];
     for k in 0..n {
         let root = find(parent, k) as usize;
         size[root] += 1;
         let d = &disks[k];
-        let (touches, slow) = supported(topo, supports, d, RESTING_STEPS * g_dt);
-        near[root] |= touches;
-        held[root] |= slow;
+        held[root] |= supported(topo, supports, d, RESTING_STEPS * g_dt);
+        meets[root] |= closing[k];
     }
     // Disks are listed in slot order, so each root (the lowest index) is its island's lowest
     // slot, and the islands come out in that order.
@@ -338,10 +354,10 @@ fn classify<V: Vector>(
             index[root] = list.len() as u32;
             let regime = if held[root] {
                 Regime::Resting
-            } else if size[root] == 1 && !near[root] {
-                Regime::Free
-            } else {
+            } else if meets[root] {
                 Regime::Impact
+            } else {
+                Regime::Free
             };
             list.push(Island {
                 first: disks[root].slot,
@@ -354,17 +370,16 @@ fn classify<V: Vector>(
     Islands { of_slot, list }
 }
 
-/// Whether disk `d` has a support (wall, fixed critter, bouncing or clamping edge) within reach,
-/// and whether it approaches one slower than `slow` (it rests on it).
+/// Whether disk `d` has a support (wall, fixed critter, bouncing or clamping edge) within reach
+/// that it approaches slower than `slow` (it rests on it).
 fn supported<V: Vector>(
     topo: &crate::border::Topology<V>,
     supports: &[Support<'_, V>],
     d: &Disk<V>,
     slow: f64,
-) -> (bool, bool) {
-    let (mut near, mut rests) = (false, false);
+) -> bool {
+    let mut rests = false;
     let mut note = |normal: V| {
-        near = true;
         // The normal points from the support to the disk: approaching is moving against it.
         rests |= -d.vel.dot(normal) < slow;
     };
@@ -405,7 +420,7 @@ fn supported<V: Vector>(
             }
         }
     }
-    (near, rests)
+    rests
 }
 
 fn count_roots(parent: &mut [u32]) -> usize {

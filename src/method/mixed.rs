@@ -1,7 +1,7 @@
 //! A step of `auto` that takes two methods at once, on islands that cannot meet within it (see
-//! [`super::islands`]): the Pop-step group (islands at rest, solved) and the event group
-//! (islands whose contacts are impacts in flight, and the free critters: they fly the exact
-//! parabola, so a free striker meets a cradle where the exact flight has it).
+//! [`super::islands`]): the Pop-step group (islands at rest, solved, and free islands, which
+//! the same step moves as the plain step does) and the event group (islands whose contacts are
+//! impacts in flight).
 //!
 //! Each group is stepped by its method's ordinary whole-scene step while the other group's
 //! critters are hidden (marked not alive for the length of that step, then shown again): every
@@ -29,8 +29,8 @@ pub(crate) const NO_GROUP: u8 = u8::MAX;
 /// The group of each island's regime.
 pub(crate) fn group_of(regime: Regime) -> u8 {
     match regime {
-        Regime::Resting => POP_GROUP,
-        Regime::Impact | Regime::Free => EVENT_GROUP,
+        Regime::Resting | Regime::Free => POP_GROUP,
+        Regime::Impact => EVENT_GROUP,
     }
 }
 
@@ -188,7 +188,7 @@ mod tests {
             s.to_string(),
             "3 islands: 192 critters in 1 island solve:8 (resting contacts under gravity); \
              5 critters in 1 island event (impacts in flight); \
-             1 critter in 1 island event (free flight, nothing within reach)"
+             1 critter in 1 island solve:8 (in flight, no two meet)"
         );
         let same = IslandSummary::of(&islands, Method::Event, Method::Event);
         assert!(!same.mixed());

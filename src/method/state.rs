@@ -130,14 +130,15 @@ impl<V: Vector> MethodState<V> {
         }
         let found = islands::partition(state);
         let has = |r: islands::Regime| found.list.iter().any(|i| i.regime == r);
-        let (impact, resting) = (has(islands::Regime::Impact), has(islands::Regime::Resting));
+        let impact = has(islands::Regime::Impact);
+        let pop = has(islands::Regime::Resting) || has(islands::Regime::Free);
         if !impact {
             // Everything rests or flies free: the whole scene's choice, as without islands.
             let plan = self.plan_whole(state);
             self.auto_islands = Some(IslandSummary::of(&found, plan.method, Method::Event));
             return Some(plan);
         }
-        if !resting {
+        if !pop {
             let critters = found.list.iter().map(|i| i.size).sum();
             let why = Why::Impacts {
                 islands: found.list.len(),
