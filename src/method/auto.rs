@@ -1,4 +1,6 @@
 //! `auto`: the cheapest method that keeps the scene's tolerances, chosen each step (`choose`).
+//! Under gravity `MethodState::plan` first cuts the critters into islands (`method::islands`):
+//! islands of impacts in flight take `event`, and `choose` decides for the rest.
 //!
 //! * **Under gravity** critters come to rest on each other, and the discrete step lets stacks
 //!   sink into themselves, so the step is solved: `solve:8`, with one sweep more per

@@ -77,6 +77,9 @@ pub struct Island {
     pub regime: Regime,
 }
 
+/// The most grid cells per disk of the partition's grid.
+const CELLS_PER_DISK: f64 = 16.0;
+
 /// Not in any island.
 pub const NO_ISLAND: u32 = u32::MAX;
 
@@ -140,9 +143,8 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
             depth[root] = depth[root].max(deepest[k]);
         }
         let mut grew = false;
-        for k in 0..n {
+        for (k, d) in disks.iter_mut().enumerate() {
             let root = find(&mut parent, k) as usize;
-            let d = &mut disks[k];
             let u = (2.0 * energy[root] * d.inv_mass).sqrt().max(d.vel.length());
             let r = reach(u, g, dt) + 2.0 * depth[root];
             if r > d.reach {
@@ -192,16 +194,21 @@ fn link_pairs<V: Vector>(
     }
     let topo = &state.topo;
     let size = topo.size();
-    // Cells twice the largest radius wide, grown so there are no more cells than disks;
-    // disks whose radius and reach pass half a cell are tested against all.
+    // Cells twice the largest diameter wide, widened only where the box would hold more than
+    // `CELLS_PER_DISK` cells per disk (a clustered scene keeps small cells); disks whose
+    // radius and reach pass half a cell are tested against all.
     let largest = disks.iter().map(|d| d.radius).fold(0.0, f64::max);
     let mut side = 4.0 * largest;
-    let volume: f64 = (0..V::DIM).map(|a| size.get(a)).product();
-    if side.powi(V::DIM as i32) * (n as f64) < volume {
-        side = (volume / n as f64).powf(1.0 / V::DIM as f64);
-    }
     if !(side.is_finite() && side > 0.0) {
         side = 1.0;
+    }
+    let cells_at = |side: f64| -> f64 {
+        (0..V::DIM)
+            .map(|a| (size.get(a) / side).floor().max(1.0))
+            .product()
+    };
+    while cells_at(side) > CELLS_PER_DISK * n as f64 {
+        side *= 2.0;
     }
     let mut dims = [1usize; 3];
     for (a, dim) in dims.iter_mut().enumerate().take(V::DIM) {
@@ -266,11 +273,11 @@ fn link_pairs<V: Vector>(
             }
         };
     let wraps = topo.wraps();
-    for a in 0..n {
+    for (a, disk) in disks.iter().enumerate() {
         if is_wide(a) {
             continue;
         }
-        let ca = coord(disks[a].pos);
+        let ca = coord(disk.pos);
         let mut lo = [0i64; 3];
         let mut hi = [0i64; 3];
         for ax in 0..3 {
