@@ -1,4 +1,6 @@
 //! `auto`: the cheapest method that keeps the scene's tolerances, chosen each step (`choose`).
+//! Under gravity `MethodState::plan` first cuts the critters into islands (`method::islands`):
+//! islands of impacts in flight take `event`, and `choose` decides for the rest.
 //!
 //! * **Under gravity** critters come to rest on each other, and the discrete step lets stacks
 //!   sink into themselves, so the step is solved: `solve:8`, with one sweep more per
@@ -120,6 +122,14 @@ pub enum Why {
         /// Without gravity: the event step, which flies the swept step's events.
         event: bool,
     },
+    /// Event under gravity: no island rests on anything, so every contact is an impact between
+    /// critters in flight (see `method::islands`).
+    Impacts {
+        /// The islands.
+        islands: usize,
+        /// The critters in them.
+        critters: usize,
+    },
 }
 
 impl std::fmt::Display for Why {
@@ -150,6 +160,10 @@ impl std::fmt::Display for Why {
             Why::Calm { fastest, smallest } => write!(
                 f,
                 "event: the fastest critter moves {fastest:.3e} per step, within {SWEEP_FRACTION} of the smallest radius or wall thickness ({smallest:.3e}), so discrete would not tunnel either; without gravity the exact event step, its flight kept from step to step, costs about what the discrete step does"
+            ),
+            Why::Impacts { islands, critters } => write!(
+                f,
+                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, and in each two critters approach each other: every contact is an impact between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum)"
             ),
             Why::Fast {
                 fastest,

@@ -12,6 +12,9 @@
 //! * [`Method::Auto`]: per step, `solve:8` (with more sweeps for deep piles) under gravity,
 //!   `event` without it, `discrete` for a slow step whose flight something outside it keeps
 //!   changing, and `swept` for a step under gravity too fast for solved substeps ([`auto`]).
+//!   Under gravity it chooses per island ([`islands`]): islands of impacts in flight (a cradle
+//!   struck in mid-air) take `event` while the islands at rest are solved, both in one step
+//!   ([`mixed`]).
 //!
 //! Every method keeps Pop's roles: a touching pair is handed to the caller's `collide` hook.
 //! `flight` is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
@@ -21,6 +24,8 @@ pub mod auto;
 pub(crate) mod discrete;
 pub(crate) mod event;
 pub(crate) mod flight;
+pub mod islands;
+pub mod mixed;
 mod queue;
 pub mod sleep;
 pub mod solve;

@@ -4,6 +4,8 @@
 
 use super::auto::{self, Why};
 use super::discrete::{self, Respond};
+use super::islands;
+use super::mixed::{self, IslandSummary, EVENT_GROUP, POP_GROUP};
 use super::solve::{self, Sweeps};
 use super::{event, flight, sleep::Sleep, swept, Method};
 use crate::border::Topology;
@@ -20,6 +22,11 @@ pub(crate) struct MethodState<V: Vector> {
     method: Method,
     /// What `auto` chose for the last step, and why.
     auto_choice: Option<(Method, Why)>,
+    /// `auto`'s islands in the last step (under gravity).
+    auto_islands: Option<IslandSummary>,
+    /// Under a mixed step, each slot's group (see `mixed`), and the slots a group hid.
+    groups: Vec<u8>,
+    hidden: Vec<u32>,
     pub(super) flight: flight::Scratch<V>,
     solve: solve::Scratch<V>,
     sleep: Sleep<V>,
@@ -37,6 +44,9 @@ pub(crate) struct Plan {
     substeps: u32,
     /// `auto`'s sweeps for a solved step.
     sweeps: Option<Sweeps>,
+    /// `auto` steps two groups of islands apart: the fields above are the Pop-step group's
+    /// plan, and the event group takes `event` (see `mixed`).
+    mixed: bool,
 }
 
 impl<V: Vector> MethodState<V> {
@@ -44,6 +54,9 @@ impl<V: Vector> MethodState<V> {
         MethodState {
             method,
             auto_choice: None,
+            auto_islands: None,
+            groups: Vec::new(),
+            hidden: Vec::new(),
             flight: Default::default(),
             solve: Default::default(),
             sleep: Sleep::new(sleep),
@@ -63,33 +76,99 @@ impl<V: Vector> MethodState<V> {
         self.auto_choice
     }
 
+    /// `auto`'s islands in the last step, when it took them (under gravity).
+    pub(crate) fn auto_islands(&self) -> Option<&IslandSummary> {
+        self.auto_islands.as_ref()
+    }
+
     /// The method for the coming step: the one asked for, or what `auto` chooses for `state`.
-    pub(crate) fn plan(&mut self, state: &State<V>) -> Plan {
+    /// (`auto` hides critters while it measures a group of islands, and shows them again.)
+    pub(crate) fn plan(&mut self, state: &mut State<V>) -> Plan {
         match self.method {
             Method::Auto => {
-                let choice = auto::choose(state, &self.flight, self.sleep.count());
-                self.auto_choice = Some((choice.method, choice.why));
-                Plan {
-                    method: choice.method,
-                    per_critter: choice.per_critter,
-                    substeps: choice.substeps,
-                    sweeps: Some(choice.sweeps),
+                if let Some(plan) = self.plan_islands(state) {
+                    return plan;
                 }
+                self.auto_islands = None;
+                self.plan_whole(state)
             }
             method => Plan {
                 method,
                 per_critter: false,
                 substeps: 1,
                 sweeps: None,
+                mixed: false,
             },
         }
+    }
+
+    /// `auto`'s plan for the whole scene at once.
+    fn plan_whole(&mut self, state: &State<V>) -> Plan {
+        let choice = auto::choose(state, &self.flight, self.sleep.count());
+        self.auto_choice = Some((choice.method, choice.why));
+        Plan {
+            method: choice.method,
+            per_critter: choice.per_critter,
+            substeps: choice.substeps,
+            sweeps: Some(choice.sweeps),
+            mixed: false,
+        }
+    }
+
+    /// `auto`'s plan by islands (see `islands`), under gravity; `None` where islands do not
+    /// apply (no gravity, where nothing rests; a fixed critter that moves).
+    fn plan_islands(&mut self, state: &mut State<V>) -> Option<Plan> {
+        if state.gravity == V::zero() {
+            return None;
+        }
+        let moving_fixed = state
+            .critters
+            .iter()
+            .any(|c| c.alive && c.fixed && !c.is_wall() && c.vel != V::zero());
+        if moving_fixed {
+            return None;
+        }
+        let found = islands::partition(state);
+        let has = |r: islands::Regime| found.list.iter().any(|i| i.regime == r);
+        let impact = has(islands::Regime::Impact);
+        let pop = has(islands::Regime::Resting) || has(islands::Regime::Free);
+        if !impact {
+            // Everything rests or flies free: the whole scene's choice, as without islands.
+            let plan = self.plan_whole(state);
+            self.auto_islands = Some(IslandSummary::of(&found, plan.method, Method::Event));
+            return Some(plan);
+        }
+        if !pop {
+            let critters = found.list.iter().map(|i| i.size).sum();
+            let why = Why::Impacts {
+                islands: found.list.len(),
+                critters,
+            };
+            self.auto_choice = Some((Method::Event, why));
+            self.auto_islands = Some(IslandSummary::of(&found, Method::Event, Method::Event));
+            return Some(Plan {
+                method: Method::Event,
+                per_critter: false,
+                substeps: 1,
+                sweeps: None,
+                mixed: false,
+            });
+        }
+        mixed::groups_by_slot(&found, &mut self.groups);
+        // The Pop-step group's plan, measured on its own critters.
+        mixed::hide(state, &self.groups, POP_GROUP, &mut self.hidden);
+        let mut plan = self.plan_whole(state);
+        mixed::show(state, &mut self.hidden);
+        plan.mixed = true;
+        self.auto_islands = Some(IslandSummary::of(&found, plan.method, Method::Event));
+        Some(plan)
     }
 
     /// True when `plan` keeps no state by slot between steps, so the critters may be laid out
     /// anew in memory (see `world::layout`).
     pub(crate) fn allows_layout(&self, plan: &Plan) -> bool {
         let slot_free = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
-        slot_free(self.method) && slot_free(plan.method)
+        slot_free(self.method) && slot_free(plan.method) && !plan.mixed
     }
 
     /// Moves and collides the critters over the step under `plan` (after the update hooks,
@@ -111,6 +190,42 @@ impl<V: Vector> MethodState<V> {
         } else {
             self.sleep.clear();
         }
+        if !plan.mixed {
+            return self.take(plan, state, pairs, stats);
+        }
+        let event = Plan {
+            method: Method::Event,
+            per_critter: false,
+            substeps: 1,
+            sweeps: None,
+            mixed: false,
+        };
+        let mut groups = std::mem::take(&mut self.groups);
+        let mut result = Ok(());
+        for (group, part) in [(POP_GROUP, plan), (EVENT_GROUP, event)] {
+            mixed::hide(state, &groups, group, &mut self.hidden);
+            // A hidden critter leaves the Verlet list: it is built anew for each group.
+            pairs.broad.forget_list();
+            result = self.take(part, state, pairs, stats);
+            mixed::show(state, &mut self.hidden);
+            state.neighbours.invalidate();
+            if result.is_err() {
+                break;
+            }
+        }
+        pairs.broad.forget_list();
+        std::mem::swap(&mut self.groups, &mut groups);
+        result
+    }
+
+    /// Takes the step's method over the critters that are alive.
+    fn take(
+        &mut self,
+        plan: Plan,
+        state: &mut State<V>,
+        pairs: &mut Pairs<V>,
+        stats: &mut StepStats,
+    ) -> Result<(), Error> {
         let dt = state.dt;
         // `auto` takes the discrete step only where nobody moves far: it is not watched.
         let watch = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
@@ -146,6 +261,7 @@ impl<V: Vector> MethodState<V> {
     /// Forgets everything kept between steps (the world was put in a recorded state).
     pub(crate) fn forget(&mut self) {
         self.auto_choice = None;
+        self.auto_islands = None;
         // The warnings are said once per run, restored or not.
         let warned = self.flight.warned_budget;
         self.flight = Default::default();

@@ -83,6 +83,10 @@ impl AnyWorld {
     pub fn auto_choice(&self) -> Option<(crate::method::Method, crate::method::auto::Why)> {
         both!(self, w => w.auto_choice())
     }
+    /// See [`crate::World::auto_islands`].
+    pub fn auto_islands(&self) -> Option<crate::method::mixed::IslandSummary> {
+        both!(self, w => w.auto_islands().cloned())
+    }
     /// How many critters sleep (under `solve:n`, [`crate::method::sleep`]).
     pub fn sleepers(&self) -> usize {
         both!(self, w => w.sleepers())

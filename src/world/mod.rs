@@ -157,6 +157,12 @@ impl<V: Vector> World<V> {
     pub fn auto_choice(&self) -> Option<(Method, Why)> {
         self.methods.auto_choice()
     }
+    /// For `auto` under gravity: the last step's islands, their sizes and the method each
+    /// regime got (`Display` writes the summary line). Under a mixed step, [`World::auto_choice`]
+    /// is the choice for the islands that do not take `event`.
+    pub fn auto_islands(&self) -> Option<&crate::method::mixed::IslandSummary> {
+        self.methods.auto_islands()
+    }
     /// Gravity.
     pub fn gravity(&self) -> V {
         self.state.gravity

@@ -21,7 +21,7 @@ impl<V: Vector> World<V> {
         self.state.neighbours.invalidate();
         timed(&mut stats.update, || update::run(&mut self.state))?;
         self.state.neighbours.invalidate();
-        let plan = self.methods.plan(&self.state);
+        let plan = self.methods.plan(&mut self.state);
         // The layout is for the broad phase's sake, which rebuilds its list after one.
         let allowed = self.methods.allows_layout(&plan);
         timed(&mut stats.pairs, || {

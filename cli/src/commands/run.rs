@@ -196,6 +196,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     if let Some((chose, why)) = scene.world.auto_choice() {
         writeln!(out, "auto chose   {chose} (last step): {why}")?;
     }
+    if let Some(islands) = scene.world.auto_islands() {
+        writeln!(out, "islands      {islands} (last step)")?;
+    }
     let stepped = scene.world.auto_choice().map_or(method, |c| c.0);
     if matches!(stepped, critterbox::method::Method::Solve(_)) {
         let how = if scene.world.sleep_allowed() {

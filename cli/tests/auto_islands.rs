@@ -1,0 +1,49 @@
+//! A mixed `auto` run (a pile solved beside a cradle flying exact events, in one step) is
+//! recorded, reports its islands, and replays and verifies from the recording alone.
+
+mod common;
+use common::{critterbox_in, text};
+
+/// A pile settling on the floor of a walled box beside a cradle struck in mid-air.
+const SCENE: &str = r#"
+let w = world(#{ dim: 2, size: vec(40, 60), gravity: vec(0, -9.81), method: "auto",
+                 seed: 5, steps: 90 });
+w.walls_around();
+for row in 0..6 {
+    for col in 0..12 {
+        let x = 1.0 + col * 1.1 + (row % 2) * 0.5;
+        spawn("ball", #{ pos: vec(x, 1.0 + row * 1.05), vel: vec(rand(-0.2, 0.2), 0),
+                         radius: 0.5, restitution: 0.5 });
+    }
+}
+spawn("ball", #{ pos: vec(20, 50), vel: vec(5, 0), radius: 0.25 });
+w.row("ball", vec(21, 50), vec(0.5, 0), 5, #{ radius: 0.25 });
+"#;
+
+#[test]
+fn a_mixed_auto_run_reports_its_islands_and_replays_bit_for_bit() {
+    let dir = common::tmp_in("auto-islands-tests", "mixed");
+    std::fs::write(dir.join("mixed.rhai"), SCENE).expect("scene written");
+    // The striker meets the cradle in steps 6 and 7: those take two methods.
+    let o = critterbox_in(&dir, &["run", "mixed.rhai", "--steps", "7"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = text(&o);
+    let islands = out
+        .lines()
+        .find(|l| l.starts_with("islands "))
+        .unwrap_or_else(|| panic!("no islands line: {out}"));
+    assert!(
+        islands.contains("6 critters in 1 island event (impacts in flight)")
+            && islands.contains("solve:8 (in flight, no two meet)"),
+        "{islands}"
+    );
+    let o = critterbox_in(&dir, &["run", "mixed.rhai", "--record", "mixed.mcap"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = critterbox_in(&dir, &["replay", "mixed.mcap", "--verify"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("verify       ok: 90 steps"),
+        "{}",
+        text(&o)
+    );
+}
