@@ -24,17 +24,31 @@ w.row("ball", vec(21, 50), vec(0.5, 0), 5, #{ radius: 0.25 });
 fn a_mixed_auto_run_reports_its_islands_and_replays_bit_for_bit() {
     let dir = common::tmp_in("auto-islands-tests", "mixed");
     std::fs::write(dir.join("mixed.rhai"), SCENE).expect("scene written");
-    // The striker meets the cradle in steps 6 and 7: those take two methods.
-    let o = critterbox_in(&dir, &["run", "mixed.rhai", "--steps", "7"]);
-    assert!(o.status.success(), "{}", text(&o));
-    let out = text(&o);
-    let islands = out
-        .lines()
-        .find(|l| l.starts_with("islands "))
-        .unwrap_or_else(|| panic!("no islands line: {out}"));
+    let islands_after = |steps: &str| {
+        let o = critterbox_in(
+            &dir,
+            &["run", "mixed.rhai", "--steps", steps, "--no-record"],
+        );
+        assert!(o.status.success(), "{}", text(&o));
+        let out = text(&o);
+        out.lines()
+            .find(|l| l.starts_with("islands "))
+            .unwrap_or_else(|| panic!("no islands line: {out}"))
+            .to_string()
+    };
+    // The striker meets the cradle in step 7, before the pile lands: nothing rests, and all
+    // flies by events.
+    let islands = islands_after("7");
     assert!(
         islands.contains("6 critters in 1 island event (impacts in flight)")
-            && islands.contains("solve:8 (in flight, no two meet)"),
+            && islands.contains("72 critters in 72 islands event (in flight, no two meet)"),
+        "{islands}"
+    );
+    // Landed, the pile is solved while the cradle's balls fly by events, in one step.
+    let islands = islands_after("30");
+    assert!(
+        islands.contains("72 critters in 1 island solve:8 (resting contacts under gravity)")
+            && islands.contains("6 critters in 2 islands event (in flight, no two meet)"),
         "{islands}"
     );
     let o = critterbox_in(&dir, &["run", "mixed.rhai", "--record", "mixed.mcap"]);

@@ -122,8 +122,8 @@ pub enum Why {
         /// Without gravity: the event step, which flies the swept step's events.
         event: bool,
     },
-    /// Event under gravity: no island rests on anything, so every contact is an impact between
-    /// critters in flight (see `method::islands`).
+    /// Event under gravity: no island rests on anything and some hold impacts between critters
+    /// in flight (see `method::islands`).
     Impacts {
         /// The islands.
         islands: usize,
@@ -163,7 +163,7 @@ impl std::fmt::Display for Why {
             ),
             Why::Impacts { islands, critters } => write!(
                 f,
-                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, and in each two critters approach each other: every contact is an impact between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum)"
+                "event: under gravity, but none of the {islands} islands ({critters} critters) rests on a wall, a fixed critter or an edge, and in some two critters approach each other: their contacts are impacts between critters in flight, which only the exact event flight keeps (a solve would spread a cradle's momentum), and the others fly free, which it keeps exactly too"
             ),
             Why::Fast {
                 fastest,

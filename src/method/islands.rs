@@ -1,26 +1,32 @@
 //! Islands for `auto`: the live disks cut into groups that cannot meet within the coming step,
 //! each with the regime that decides its method ([`partition`]).
 //!
-//! **Reach.** A free disk moves in a step at most `(u + 2|g| dt) dt`, where `u` bounds its speed:
-//! collisions inside its island (restitution at most 1, walls and fixed critters not moving)
-//! cannot give it more than all of its island's kinetic energy, `u = sqrt(2 E / m)`, and
-//! gravity adds `|g| dt` to a speed over the step (twice, for a bounce off a support). Two disks
-//! are in one island when their gap is within their two reaches (with the island's deepest
-//! overlap added, which the separation may push a disk by); since the reach depends on the
-//! island, the partition is repeated with the islands' reaches until no two islands join. Two
-//! islands then cannot touch during the step, so stepping each alone gives the same result as
-//! stepping them together. Walls, fixed critters and the world's bouncing edges join no island:
-//! every island sees them all.
+//! **Own reach first.** A free disk moves in a step at most `(v + 2|g| dt) dt` at its own speed
+//! `v` (gravity adds `|g| dt` to a speed over the step, twice for a bounce off a support). Disks
+//! whose gap is within their two reaches are joined (a hashed grid, about two buckets per
+//! disk; the few fastest or largest disks are tested against all). At these reaches each
+//! island gets its regime ([`Regime`]), under gravity:
+//! - *resting*: a disk of it is within reach of a wall, a fixed critter, a bouncing edge or a
+//!   sleeper of `solve:n` and approaches it slower than [`RESTING_STEPS`] steps of gravity: it
+//!   is held up, and its contacts carry weight, which is what `solve:N` is for;
+//! - *impacts*: held up by nothing, and two of its disks within reach approach each other. It
+//!   falls as a whole, gravity does not change its disks' relative motion, and its contacts are
+//!   impacts (a cradle struck in mid-air, a clump thrown): only the exact event flight keeps
+//!   them;
+//! - *free*: held up by nothing, and no two of its disks approach each other.
 //!
-//! **Regime** ([`Regime`]), under gravity: an island is *resting* when one of its disks is
-//! within reach of a wall, a fixed critter or a bouncing edge and approaches it slower than
-//! [`RESTING_STEPS`] steps of gravity (`|g| dt`): it is held up, and its contacts carry weight,
-//! which is what `solve:N` is for. An island held up by nothing falls freely as a whole: gravity
-//! does not change its disks' relative motion, so when two of its disks within reach approach
-//! each other its contacts are *impacts* (a cradle struck in mid-air, a clump thrown), and only
-//! the exact event flight keeps them (a solve spreads a cradle's momentum over its balls).
-//! Otherwise it is *free*: no two of its disks meet in the step (at most one hits a wall), and
-//! it goes with the resting islands' step, which moves it as the plain step does.
+//! **Then each island's energy, when the step may be cut.** When every island rests, or none
+//! rests and none holds impacts, the whole scene takes one method and these islands are final.
+//! Otherwise the islands must not meet: collisions inside an island (restitution at most 1,
+//! walls and fixed critters not moving) cannot give a disk more than all of its island's
+//! kinetic energy, `u = sqrt(2 E / m)`, so its reach grows to that speed's, plus twice the
+//! island's deepest overlap (which a separation may push a disk by). Islands whose boxes meet
+//! are tested disk by disk with these reaches and joined, and this repeats until no two join
+//! (joining only adds energy). Two islands then cannot touch during the step, so stepping each
+//! alone gives the same result as stepping them together. Joining keeps an island of impacts
+//! held by nothing and makes an island rest when a part rested, so the regimes read at own
+//! reach carry over. Walls, fixed critters, the world's bouncing edges and sleepers (which do
+//! not move) join no island: every island sees them all.
 //!
 //! Determinism: the union keeps the lower slot as each root, and islands are listed by their
 //! lowest slot, so the result depends on neither thread count nor the order of the passes.
@@ -77,11 +83,14 @@ pub struct Island {
     pub regime: Regime,
 }
 
-/// The most grid cells per disk of the partition's grid.
-const CELLS_PER_DISK: f64 = 16.0;
+/// Disks whose radius and reach pass the cells' are tested against all; the grid's cells are
+/// sized so that at most this many do.
+const MOST_WIDE: usize = 16;
 
 /// Not in any island.
 pub const NO_ISLAND: u32 = u32::MAX;
+/// A sleeper in no island: no awake disk can reach it in the step.
+pub const ASLEEP: u32 = u32::MAX - 1;
 
 /// What the partition reads of a disk.
 struct Disk<V> {
@@ -92,6 +101,8 @@ struct Disk<V> {
     inv_mass: f64,
     /// How far it may move in the step.
     reach: f64,
+    /// A sleeper of `solve:n` (it does not move).
+    asleep: bool,
 }
 
 /// The supports: walls and fixed critters (which join no island).
@@ -100,7 +111,11 @@ struct Support<'a, V: Vector> {
 }
 
 /// Partitions the live disks of `state` into islands (see the module docs).
-pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
+///
+/// `asleep` marks, by slot, the sleepers of `solve:n` (empty when none sleeps): they do not
+/// move in the step, so they are only tested against awake disks, and an island that holds one
+/// rests on it. Sleepers that no awake disk can reach belong to no island ([`ASLEEP`]).
+pub(crate) fn partition<V: Vector>(state: &State<V>, asleep: &[bool]) -> Islands {
     let (g, dt) = (state.gravity.length(), state.dt);
     let slots = state.critters.slot_slice();
     let mut disks = Vec::new();
@@ -119,6 +134,7 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
                 radius: c.radius,
                 inv_mass: c.inv_mass(),
                 reach: 0.0,
+                asleep: asleep.get(i).copied().unwrap_or(false),
             });
         }
     }
@@ -130,7 +146,20 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
     }
     let mut deepest = vec![0.0f64; n];
     let mut closing = vec![false; n];
-    link_pairs(state, &disks, &mut parent, &mut deepest, &mut closing);
+    link_pairs(
+        state,
+        &disks,
+        &mut parent,
+        Some((&mut deepest, &mut closing)),
+    );
+    // Held and approaching are read at the disks' own reaches; wider reaches only join islands.
+    let held: Vec<bool> = disks
+        .iter()
+        .map(|d| d.asleep || supported(&state.topo, &supports, d, RESTING_STEPS * g * dt))
+        .collect();
+    if !may_mix(&held, &closing, &mut parent) {
+        return classify(&disks, &held, &closing, &mut parent, slots.len());
+    }
     loop {
         // The islands' energies and deepest overlaps, gathered at their roots.
         let mut energy = vec![0.0f64; n];
@@ -156,21 +185,18 @@ pub(crate) fn partition<V: Vector>(state: &State<V>) -> Islands {
             break;
         }
         // Wider reaches may join islands: link again, and stop when none joined.
-        let before = count_roots(&mut parent);
-        link_pairs(state, &disks, &mut parent, &mut deepest, &mut closing);
-        if count_roots(&mut parent) == before {
+        let joined = if state.topo.wraps() {
+            let before = count_roots(&mut parent);
+            link_pairs(state, &disks, &mut parent, None);
+            count_roots(&mut parent) != before
+        } else {
+            link_islands(&disks, &mut parent)
+        };
+        if !joined {
             break;
         }
     }
-    classify(
-        state,
-        &disks,
-        &supports,
-        &closing,
-        &mut parent,
-        slots.len(),
-        g * dt,
-    )
+    classify(&disks, &held, &closing, &mut parent, slots.len())
 }
 
 /// How far a disk at speed `u` may move in a step (see the module docs), with a margin for
@@ -185,8 +211,7 @@ fn link_pairs<V: Vector>(
     state: &State<V>,
     disks: &[Disk<V>],
     parent: &mut [u32],
-    deepest: &mut [f64],
-    closing: &mut [bool],
+    mut first: Option<(&mut [f64], &mut [bool])>,
 ) {
     let n = disks.len();
     if n < 2 {
@@ -194,21 +219,20 @@ fn link_pairs<V: Vector>(
     }
     let topo = &state.topo;
     let size = topo.size();
-    // Cells twice the largest diameter wide, widened only where the box would hold more than
-    // `CELLS_PER_DISK` cells per disk (a clustered scene keeps small cells); disks whose
-    // radius and reach pass half a cell are tested against all.
-    let largest = disks.iter().map(|d| d.radius).fold(0.0, f64::max);
-    let mut side = 4.0 * largest;
+    // Cells twice as wide as the largest radius plus reach, save the `MOST_WIDE` largest:
+    // those disks are tested against all (a few fast or large disks do not widen every cell).
+    // The cells are hashed into about two buckets per disk, so a large box with a small pile
+    // keeps small cells.
+    let mut spans: Vec<f64> = disks.iter().map(|d| d.radius + d.reach).collect();
+    let widest = if n > MOST_WIDE {
+        let (_, nth, _) = spans.select_nth_unstable_by(MOST_WIDE, |a, b| b.total_cmp(a));
+        *nth
+    } else {
+        spans.iter().copied().fold(0.0, f64::max)
+    };
+    let mut side = 2.0 * widest;
     if !(side.is_finite() && side > 0.0) {
         side = 1.0;
-    }
-    let cells_at = |side: f64| -> f64 {
-        (0..V::DIM)
-            .map(|a| (size.get(a) / side).floor().max(1.0))
-            .product()
-    };
-    while cells_at(side) > CELLS_PER_DISK * n as f64 {
-        side *= 2.0;
     }
     let mut dims = [1usize; 3];
     for (a, dim) in dims.iter_mut().enumerate().take(V::DIM) {
@@ -228,8 +252,14 @@ fn link_pairs<V: Vector>(
         }
         c
     };
-    let key = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
-    let cells = dims[0] * dims[1] * dims[2];
+    let bits = (2 * n).next_power_of_two().trailing_zeros().max(1);
+    let cells = 1usize << bits;
+    // A cell's bucket (Fibonacci hashing of its index); cells that share one are both
+    // visited, which only repeats tests.
+    let key = |c: [usize; 3]| {
+        let index = ((c[2] as u64 * dims[1] as u64) + c[1] as u64) * dims[0] as u64 + c[0] as u64;
+        (index.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize
+    };
     let wide: Vec<usize> = (0..n)
         .filter(|&k| disks[k].radius + disks[k].reach > 0.5 * narrowest)
         .collect();
@@ -255,26 +285,35 @@ fn link_pairs<V: Vector>(
             fill[cell_of[k]] += 1;
         }
     }
+    // The first pass (own reaches) also notes approaching pairs and overlaps.
     let test =
-        |a: usize, b: usize, parent: &mut [u32], deepest: &mut [f64], closing: &mut [bool]| {
+        |a: usize, b: usize, parent: &mut [u32], first: &mut Option<(&mut [f64], &mut [bool])>| {
             let (da, db) = (&disks[a], &disks[b]);
+            if da.asleep && db.asleep {
+                return; // neither moves
+            }
             let offset = topo.delta(da.pos, db.pos);
-            let gap = offset.length() - da.radius - db.radius;
-            if gap <= da.reach + db.reach {
+            let (dist2, touch) = (offset.length_squared(), da.radius + db.radius);
+            let within = touch + da.reach + db.reach;
+            if dist2 <= within * within {
                 union(parent, a, b);
-                if (db.vel - da.vel).dot(offset) < 0.0 {
-                    closing[a] = true;
-                    closing[b] = true;
-                }
-                if gap < 0.0 {
-                    deepest[a] = deepest[a].max(-gap);
-                    deepest[b] = deepest[b].max(-gap);
+                if let Some((deepest, closing)) = first {
+                    if (db.vel - da.vel).dot(offset) < 0.0 {
+                        closing[a] = true;
+                        closing[b] = true;
+                    }
+                    if dist2 < touch * touch {
+                        let depth = touch - dist2.sqrt();
+                        deepest[a] = deepest[a].max(depth);
+                        deepest[b] = deepest[b].max(depth);
+                    }
                 }
             }
         };
     let wraps = topo.wraps();
+    // Awake disks look around their cells; sleepers are only looked at.
     for (a, disk) in disks.iter().enumerate() {
-        if is_wide(a) {
+        if is_wide(a) || disk.asleep {
             continue;
         }
         let ca = coord(disk.pos);
@@ -286,7 +325,9 @@ fn link_pairs<V: Vector>(
                 hi[ax] = ca[ax] as i64 + 1;
             }
         }
-        let mut seen: Vec<usize> = Vec::with_capacity(27);
+        // Few cells along an axis repeat a neighbour: each cell is visited once.
+        let mut seen = [usize::MAX; 27];
+        let mut seen_count = 0;
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
@@ -306,13 +347,14 @@ fn link_pairs<V: Vector>(
                         continue;
                     }
                     let k = key(c);
-                    if seen.contains(&k) {
-                        continue; // few cells along an axis: the neighbours repeat
+                    if seen[..seen_count].contains(&k) {
+                        continue;
                     }
-                    seen.push(k);
+                    seen[seen_count] = k;
+                    seen_count += 1;
                     for &b in &order[start[k]..start[k + 1]] {
-                        if b > a {
-                            test(a, b, parent, deepest, closing);
+                        if b > a || disks[b].asleep {
+                            test(a, b, parent, &mut first);
                         }
                     }
                 }
@@ -322,33 +364,133 @@ fn link_pairs<V: Vector>(
     for &a in &wide {
         for b in 0..n {
             if b != a && (!is_wide(b) || b > a) {
-                test(a, b, parent, deepest, closing);
+                test(a, b, parent, &mut first);
             }
         }
     }
 }
 
-/// Names the islands by their lowest slot and finds each one's regime.
+/// Two islands whose disks make more pairs than this are joined when their boxes meet, without
+/// testing the pairs (joining more is always safe).
+const MOST_PAIRS_TESTED: usize = 1 << 14;
+
+/// Joins the islands of `parent` that hold two disks within their reaches; true when some
+/// joined. Each island's box (its disks' centres widened by radius and reach) is swept along x
+/// against the others' (a border that does not wrap), so only islands whose boxes meet are
+/// tested disk by disk; the joins are made after the sweep, in the order found.
+fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
+    let n = disks.len();
+    // Per root: its box and its disks (a counting sort by root).
+    let mut root_of = vec![0u32; n];
+    let mut awake = vec![false; n];
+    let mut count = vec![0usize; n + 1];
+    let mut lo = vec![V::splat(f64::INFINITY); n];
+    let mut hi = vec![V::splat(f64::NEG_INFINITY); n];
+    for (k, d) in disks.iter().enumerate() {
+        let r = find(parent, k) as usize;
+        root_of[k] = r as u32;
+        count[r + 1] += 1;
+        awake[r] |= !d.asleep;
+        let w = d.radius + d.reach;
+        for ax in 0..V::DIM {
+            let x = d.pos.get(ax);
+            let (l, h) = (lo[r].get(ax).min(x - w), hi[r].get(ax).max(x + w));
+            lo[r].set(ax, l);
+            hi[r].set(ax, h);
+        }
+    }
+    for r in 0..n {
+        count[r + 1] += count[r];
+    }
+    let mut fill = count.clone();
+    let mut members = vec![0usize; n];
+    for (k, &r) in root_of.iter().enumerate() {
+        members[fill[r as usize]] = k;
+        fill[r as usize] += 1;
+    }
+    let mut roots: Vec<usize> = (0..n).filter(|&r| count[r + 1] > count[r]).collect();
+    roots.sort_by(|&a, &b| lo[a].get(0).total_cmp(&lo[b].get(0)).then(a.cmp(&b)));
+    let meet = |a: usize, b: usize| {
+        (0..V::DIM).all(|ax| lo[a].get(ax) <= hi[b].get(ax) && lo[b].get(ax) <= hi[a].get(ax))
+    };
+    let mut joins = Vec::new();
+    for (i, &a) in roots.iter().enumerate() {
+        for &b in &roots[i + 1..] {
+            if lo[b].get(0) > hi[a].get(0) {
+                break;
+            }
+            if !(awake[a] || awake[b]) || !meet(a, b) {
+                continue;
+            }
+            let (da, db) = (
+                &members[count[a]..count[a + 1]],
+                &members[count[b]..count[b + 1]],
+            );
+            let near = da.len() * db.len() > MOST_PAIRS_TESTED
+                || da.iter().any(|&p| {
+                    db.iter().any(|&q| {
+                        let (dp, dq) = (&disks[p], &disks[q]);
+                        if dp.asleep && dq.asleep {
+                            return false;
+                        }
+                        let gap = (dq.pos - dp.pos).length() - dp.radius - dq.radius;
+                        gap <= dp.reach + dq.reach
+                    })
+                });
+            if near {
+                joins.push((a, b));
+            }
+        }
+    }
+    for &(a, b) in &joins {
+        union(parent, a, b);
+    }
+    !joins.is_empty()
+}
+
+/// Whether the islands of `parent` may end in more than one group: some island is held by
+/// nothing and has two disks approaching each other (impacts), or some are held and some are
+/// not. Joining islands keeps an island of impacts held by nothing and approaching, and an
+/// island held when a part was, so without either these islands already decide the step.
+fn may_mix(held: &[bool], closing: &[bool], parent: &mut [u32]) -> bool {
+    let n = held.len();
+    let (mut root_held, mut root_meets) = (vec![false; n], vec![false; n]);
+    for k in 0..n {
+        let root = find(parent, k) as usize;
+        root_held[root] |= held[k];
+        root_meets[root] |= closing[k];
+    }
+    let (mut any_held, mut any_loose) = (false, false);
+    for r in (0..n).filter(|&r| find(parent, r) as usize == r) {
+        if !root_held[r] && root_meets[r] {
+            return true;
+        }
+        any_held |= root_held[r];
+        any_loose |= !root_held[r];
+    }
+    any_held && any_loose
+}
+
+/// Names the islands by their lowest slot and finds each one's regime (held and approaching
+/// as read at the disks' own reaches).
 fn classify<V: Vector>(
-    state: &State<V>,
     disks: &[Disk<V>],
-    supports: &[Support<'_, V>],
+    held_disk: &[bool],
     closing: &[bool],
     parent: &mut [u32],
     slot_count: usize,
-    g_dt: f64,
 ) -> Islands {
     let n = disks.len();
-    let topo = &state.topo;
     let mut size = vec![0usize; n];
     let mut meets = vec![false; n];
     let mut held = vec![false; n];
+    let mut awake = vec![false; n];
     for k in 0..n {
         let root = find(parent, k) as usize;
         size[root] += 1;
-        let d = &disks[k];
-        held[root] |= supported(topo, supports, d, RESTING_STEPS * g_dt);
+        held[root] |= held_disk[k];
         meets[root] |= closing[k];
+        awake[root] |= !disks[k].asleep;
     }
     // Disks are listed in slot order, so each root (the lowest index) is its island's lowest
     // slot, and the islands come out in that order.
@@ -357,6 +499,10 @@ fn classify<V: Vector>(
     let mut list = Vec::new();
     for k in 0..n {
         let root = find(parent, k) as usize;
+        if !awake[root] {
+            of_slot[disks[k].slot as usize] = ASLEEP;
+            continue;
+        }
         if index[root] == NO_ISLAND {
             index[root] = list.len() as u32;
             let regime = if held[root] {

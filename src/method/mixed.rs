@@ -1,22 +1,23 @@
 //! A step of `auto` that takes two methods at once, on islands that cannot meet within it (see
-//! [`super::islands`]): the Pop-step group (islands at rest, solved, and free islands, which
-//! the same step moves as the plain step does) and the event group (islands whose contacts are
-//! impacts in flight).
+//! [`super::islands`]): the Pop-step group (islands at rest, solved, with the solve's sleepers)
+//! and the event group (islands of impacts in flight, and islands in free flight, which would
+//! otherwise cut the solve into substeps for their speed and keep it awake).
 //!
 //! Each group is stepped by its method's ordinary whole-scene step while the other group's
 //! critters are hidden (marked not alive for the length of that step, then shown again): every
 //! method already passes over dead critters, so none needs a mask of its own, and the fixed
 //! methods stay as they are. Walls and fixed critters are never hidden; a fixed critter that
 //! moves would be moved once per group, so a scene with one is stepped whole. The groups go in
-//! a fixed order (Pop-step first), so the step's events come in a deterministic order. The
-//! broad phase's Verlet list is dropped around each group (a hidden critter leaves it), and the
-//! event flight, under gravity, is set up anew every step anyway, so nothing a group keeps
-//! between steps depends on the other group: a recording restores and verifies as for any step.
+//! a fixed order (Pop-step first), so the step's events come in a deterministic order. Each
+//! group keeps a broad phase of its own (its Verlet list holds only its critters), both
+//! forgotten when a critter changes group; the event flight, under gravity, is set up anew
+//! every step anyway, so nothing a group keeps between steps changes the result, and a
+//! recording restores and verifies as for any step.
 //!
 //! While a group is stepped, hooks that look around (`nearby`) do not see the other group:
 //! it is out of reach for the whole step.
 
-use super::islands::{Islands, Regime, NO_ISLAND};
+use super::islands::{Islands, Regime, ASLEEP, NO_ISLAND};
 use super::Method;
 use crate::vector::Vector;
 use crate::world::state::State;
@@ -26,22 +27,26 @@ pub(crate) const POP_GROUP: u8 = 0;
 pub(crate) const EVENT_GROUP: u8 = 1;
 pub(crate) const NO_GROUP: u8 = u8::MAX;
 
-/// The group of each island's regime.
-pub(crate) fn group_of(regime: Regime) -> u8 {
+/// The group of an island's regime. Free islands fly with the event group when `free_flies`
+/// (beside islands at rest, whose solve they would otherwise cut into substeps and keep awake).
+pub(crate) fn group_of(regime: Regime, free_flies: bool) -> u8 {
     match regime {
-        Regime::Resting | Regime::Free => POP_GROUP,
-        Regime::Impact => EVENT_GROUP,
+        Regime::Resting => POP_GROUP,
+        Regime::Free if !free_flies => POP_GROUP,
+        Regime::Free | Regime::Impact => EVENT_GROUP,
     }
 }
 
-/// Each slot's group, from the step's islands.
-pub(crate) fn groups_by_slot(islands: &Islands, out: &mut Vec<u8>) {
+/// Each slot's group, from the step's islands (sleepers with the solve).
+pub(crate) fn groups_by_slot(islands: &Islands, free_flies: bool, out: &mut Vec<u8>) {
     out.clear();
     out.extend(islands.of_slot.iter().map(|&i| {
         if i == NO_ISLAND {
             NO_GROUP
+        } else if i == ASLEEP {
+            POP_GROUP // the solve's sleepers
         } else {
-            group_of(islands.list[i as usize].regime)
+            group_of(islands.list[i as usize].regime, free_flies)
         }
     }));
 }
@@ -82,8 +87,10 @@ pub(crate) fn show<V: Vector>(state: &mut State<V>, hidden: &mut Vec<u32>) {
 pub struct IslandSummary {
     /// All islands.
     pub islands: usize,
-    /// Per regime present (free, resting, impact, in that order).
+    /// Per regime present (resting, impact, free, in that order).
     pub parts: Vec<IslandPart>,
+    /// Sleepers in no island (stepped by the solve, which keeps them still).
+    pub asleep: usize,
 }
 
 /// The islands of one regime.
@@ -100,8 +107,14 @@ pub struct IslandPart {
 }
 
 impl IslandSummary {
-    /// Sums the islands up, the Pop-step group taking `pop` and the event group `event`.
-    pub(crate) fn of(islands: &Islands, pop: Method, event: Method) -> IslandSummary {
+    /// Sums the islands up, the Pop-step group taking `pop` and the event group `event`
+    /// (`free_flies` as for [`group_of`]).
+    pub(crate) fn of(
+        islands: &Islands,
+        pop: Method,
+        event: Method,
+        free_flies: bool,
+    ) -> IslandSummary {
         let mut parts: Vec<IslandPart> = Vec::new();
         for regime in [Regime::Resting, Regime::Impact, Regime::Free] {
             let (mut count, mut critters) = (0, 0);
@@ -114,7 +127,7 @@ impl IslandSummary {
                     regime,
                     islands: count,
                     critters,
-                    method: if group_of(regime) == POP_GROUP {
+                    method: if group_of(regime, free_flies) == POP_GROUP {
                         pop
                     } else {
                         event
@@ -125,6 +138,7 @@ impl IslandSummary {
         IslandSummary {
             islands: islands.list.len(),
             parts,
+            asleep: islands.of_slot.iter().filter(|&&i| i == ASLEEP).count(),
         }
     }
 
@@ -157,6 +171,10 @@ impl std::fmt::Display for IslandSummary {
                 p.regime.describe()
             )?;
         }
+        if self.asleep > 0 {
+            let sep = if self.parts.is_empty() { ":" } else { ";" };
+            write!(f, "{sep} {} asleep", self.asleep)?;
+        }
         Ok(())
     }
 }
@@ -182,7 +200,7 @@ mod tests {
                 island(197, 1, Regime::Free),
             ],
         };
-        let s = IslandSummary::of(&islands, Method::Solve(8), Method::Event);
+        let s = IslandSummary::of(&islands, Method::Solve(8), Method::Event, false);
         assert!(s.mixed());
         assert_eq!(
             s.to_string(),
@@ -190,7 +208,9 @@ mod tests {
              5 critters in 1 island event (impacts in flight); \
              1 critter in 1 island solve:8 (in flight, no two meet)"
         );
-        let same = IslandSummary::of(&islands, Method::Event, Method::Event);
+        let same = IslandSummary::of(&islands, Method::Event, Method::Event, false);
+        let flies = IslandSummary::of(&islands, Method::Solve(8), Method::Event, true);
+        assert_eq!(flies.parts[2].method, Method::Event);
         assert!(!same.mixed());
     }
 }

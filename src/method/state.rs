@@ -9,6 +9,7 @@ use super::mixed::{self, IslandSummary, EVENT_GROUP, POP_GROUP};
 use super::solve::{self, Sweeps};
 use super::{event, flight, sleep::Sleep, swept, Method};
 use crate::border::Topology;
+use crate::broad_phase::BroadPhase;
 use crate::critter::Critter;
 use crate::error::Error;
 use crate::vector::Vector;
@@ -27,6 +28,10 @@ pub(crate) struct MethodState<V: Vector> {
     /// Under a mixed step, each slot's group (see `mixed`), and the slots a group hid.
     groups: Vec<u8>,
     hidden: Vec<u32>,
+    /// The groups of the last step when it was mixed (else empty): while they stay the same,
+    /// each group keeps its broad phase's list, the event group's here.
+    last_groups: Vec<u8>,
+    event_broad: Option<BroadPhase<V>>,
     pub(super) flight: flight::Scratch<V>,
     solve: solve::Scratch<V>,
     sleep: Sleep<V>,
@@ -57,6 +62,8 @@ impl<V: Vector> MethodState<V> {
             auto_islands: None,
             groups: Vec::new(),
             hidden: Vec::new(),
+            last_groups: Vec::new(),
+            event_broad: None,
             flight: Default::default(),
             solve: Default::default(),
             sleep: Sleep::new(sleep),
@@ -116,7 +123,8 @@ impl<V: Vector> MethodState<V> {
     }
 
     /// `auto`'s plan by islands (see `islands`), under gravity; `None` where islands do not
-    /// apply (no gravity, where nothing rests; a fixed critter that moves).
+    /// apply (no gravity, where nothing rests; a fixed critter that moves). A whole scene that
+    /// needs the swept step takes it whole.
     fn plan_islands(&mut self, state: &mut State<V>) -> Option<Plan> {
         if state.gravity == V::zero() {
             return None;
@@ -128,24 +136,53 @@ impl<V: Vector> MethodState<V> {
         if moving_fixed {
             return None;
         }
-        let found = islands::partition(state);
-        let has = |r: islands::Regime| found.list.iter().any(|i| i.regime == r);
-        let impact = has(islands::Regime::Impact);
-        let pop = has(islands::Regime::Resting) || has(islands::Regime::Free);
-        if !impact {
-            // Everything rests or flies free: the whole scene's choice, as without islands.
+        // Something fast meets something thin: the swept step flies the whole scene's impacts
+        // in time order already, its resting contacts included, and islands would add nothing.
+        let whole = self.plan_whole(state);
+        if whole.method == Method::Swept {
+            self.auto_islands = None;
+            return Some(whole);
+        }
+        // Sleepers the update hooks moved wake now, as the step would wake them, so that the
+        // partition takes only true sleepers as still.
+        if self.sleep.count() > 0 {
+            self.sleep.check(state.critters.slot_slice());
+        }
+        let found = islands::partition(state, self.sleep.still());
+        let r = self.plan_found(state, &found);
+        match r {
+            // Sleepers keep still only under a solve: otherwise they are disks like any other.
+            Some(plan) if self.sleep.count() > 0 && !matches!(plan.method, Method::Solve(_)) => {
+                let found = islands::partition(state, &[]);
+                self.plan_found(state, &found)
+            }
+            plan => plan,
+        }
+    }
+
+    /// `auto`'s plan for the islands `found`: with no island of impacts and none at rest beside
+    /// free ones, the whole scene's choice; with none at rest, `event` for all; otherwise a
+    /// mixed step, the islands at rest solved (the whole scene's choice for them) and the
+    /// islands of impacts and in free flight flown by `event`.
+    fn plan_found(&mut self, state: &mut State<V>, found: &islands::Islands) -> Option<Plan> {
+        use islands::Regime;
+        let has = |r: Regime| found.list.iter().any(|i| i.regime == r);
+        let resting = has(Regime::Resting) || found.of_slot.contains(&islands::ASLEEP);
+        let (impact, free) = (has(Regime::Impact), has(Regime::Free));
+        if !(impact || resting && free) {
+            // Everything rests, or flies free with nothing at rest: as without islands.
             let plan = self.plan_whole(state);
-            self.auto_islands = Some(IslandSummary::of(&found, plan.method, Method::Event));
+            self.auto_islands = Some(IslandSummary::of(found, plan.method, Method::Event, false));
             return Some(plan);
         }
-        if !pop {
+        if !resting {
             let critters = found.list.iter().map(|i| i.size).sum();
             let why = Why::Impacts {
                 islands: found.list.len(),
                 critters,
             };
             self.auto_choice = Some((Method::Event, why));
-            self.auto_islands = Some(IslandSummary::of(&found, Method::Event, Method::Event));
+            self.auto_islands = Some(IslandSummary::of(found, Method::Event, Method::Event, true));
             return Some(Plan {
                 method: Method::Event,
                 per_critter: false,
@@ -154,13 +191,13 @@ impl<V: Vector> MethodState<V> {
                 mixed: false,
             });
         }
-        mixed::groups_by_slot(&found, &mut self.groups);
+        mixed::groups_by_slot(found, true, &mut self.groups);
         // The Pop-step group's plan, measured on its own critters.
         mixed::hide(state, &self.groups, POP_GROUP, &mut self.hidden);
         let mut plan = self.plan_whole(state);
         mixed::show(state, &mut self.hidden);
         plan.mixed = true;
-        self.auto_islands = Some(IslandSummary::of(&found, plan.method, Method::Event));
+        self.auto_islands = Some(IslandSummary::of(found, plan.method, Method::Event, true));
         Some(plan)
     }
 
@@ -191,6 +228,11 @@ impl<V: Vector> MethodState<V> {
             self.sleep.clear();
         }
         if !plan.mixed {
+            if !self.last_groups.is_empty() {
+                // The list was the Pop-step group's.
+                pairs.broad.forget_list();
+                self.last_groups.clear();
+            }
             return self.take(plan, state, pairs, stats);
         }
         let event = Plan {
@@ -201,19 +243,34 @@ impl<V: Vector> MethodState<V> {
             mixed: false,
         };
         let mut groups = std::mem::take(&mut self.groups);
+        let mut event_broad = self
+            .event_broad
+            .take()
+            .unwrap_or_else(|| BroadPhase::new(pairs.broad.mode));
+        if groups != self.last_groups {
+            // A list holds only the critters its group had: a critter that changed group (or
+            // came) is in neither.
+            pairs.broad.forget_list();
+            event_broad.forget_list();
+        }
         let mut result = Ok(());
         for (group, part) in [(POP_GROUP, plan), (EVENT_GROUP, event)] {
             mixed::hide(state, &groups, group, &mut self.hidden);
-            // A hidden critter leaves the Verlet list: it is built anew for each group.
-            pairs.broad.forget_list();
+            if group == EVENT_GROUP {
+                std::mem::swap(&mut pairs.broad, &mut event_broad);
+            }
             result = self.take(part, state, pairs, stats);
+            if group == EVENT_GROUP {
+                std::mem::swap(&mut pairs.broad, &mut event_broad);
+            }
             mixed::show(state, &mut self.hidden);
             state.neighbours.invalidate();
             if result.is_err() {
                 break;
             }
         }
-        pairs.broad.forget_list();
+        self.event_broad = Some(event_broad);
+        self.last_groups.clone_from(&groups);
         std::mem::swap(&mut self.groups, &mut groups);
         result
     }
@@ -262,6 +319,8 @@ impl<V: Vector> MethodState<V> {
     pub(crate) fn forget(&mut self) {
         self.auto_choice = None;
         self.auto_islands = None;
+        self.last_groups.clear();
+        self.event_broad = None;
         // The warnings are said once per run, restored or not.
         let warned = self.flight.warned_budget;
         self.flight = Default::default();
