@@ -16,7 +16,7 @@ const RUNS: &[(&str, &str)] = &[
     ("gas3d --seed 7 --steps 200", "f7c50535fce94e57"),
     ("scripts/scenes/billiards.rhai", "c02ace5aaf1eb598"),
     ("scripts/scenes/pile.rhai", "2b1184202c45e783"),
-    ("pegs --method auto --steps 300", "4c06d02b4ec87c16"),
+    ("pegs --method auto --steps 300", "e96c265a50357a8f"),
     ("gas --method event -n 2000 --steps 200", "d9cea4352889a91e"),
     (
         "gas --method substep:3 --steps 150 -n 400",
@@ -89,7 +89,7 @@ const RUNS: &[(&str, &str)] = &[
     ),
     (
         "scripts/scenes/pile.rhai --method auto --steps 200",
-        "a795edd1fd898c85",
+        "bf14155d71620790",
     ),
     (
         "scripts/scenes/pile.rhai --method event --steps 200",

@@ -13,6 +13,8 @@
 //!   falls as a whole, gravity does not change its disks' relative motion, and its contacts are
 //!   impacts (a cradle struck in mid-air, a clump thrown): only the exact event flight keeps
 //!   them;
+//! - *clump*: as impacts, but a disk of it is not perfectly elastic: a chain of inelastic
+//!   impacts need not end within the step (inelastic collapse), so it is solved;
 //! - *free*: held up by nothing, and no two of its disks approach each other.
 //!
 //! **Then each island's energy, when the step may be cut.** When every island rests, or none
@@ -48,8 +50,12 @@ pub enum Regime {
     Free,
     /// Held up by a wall, a fixed critter or an edge: its contacts carry weight.
     Resting,
-    /// Held up by nothing: its contacts are impacts between disks in flight.
+    /// Held up by nothing: its contacts are impacts between perfectly elastic disks in flight.
     Impact,
+    /// Held up by nothing, two of its disks approach each other, and one is not perfectly
+    /// elastic: a chain of inelastic impacts need not end within the step (inelastic collapse),
+    /// so it is solved as a resting island is.
+    Clump,
 }
 
 impl Regime {
@@ -59,6 +65,7 @@ impl Regime {
             Regime::Free => "in flight, no two meet",
             Regime::Resting => "resting contacts under gravity",
             Regime::Impact => "impacts in flight",
+            Regime::Clump => "inelastic impacts in flight",
         }
     }
 }
@@ -103,6 +110,8 @@ struct Disk<V> {
     reach: f64,
     /// A sleeper of `solve:n` (it does not move).
     asleep: bool,
+    /// Restitution 1.
+    elastic: bool,
 }
 
 /// The supports: walls and fixed critters (which join no island).
@@ -135,10 +144,22 @@ pub(crate) fn partition<V: Vector>(state: &State<V>, asleep: &[bool]) -> Islands
                 inv_mass: c.inv_mass(),
                 reach: 0.0,
                 asleep: asleep.get(i).copied().unwrap_or(false),
+                elastic: c.restitution() >= 1.0,
             });
         }
     }
     let n = disks.len();
+    if disks.iter().all(|d| d.asleep) {
+        // A pile asleep whole: nothing to cut (and nothing to pay for it).
+        let mut of_slot = vec![NO_ISLAND; slots.len()];
+        for d in &disks {
+            of_slot[d.slot as usize] = ASLEEP;
+        }
+        return Islands {
+            of_slot,
+            list: Vec::new(),
+        };
+    }
     let mut parent: Vec<u32> = (0..n as u32).collect();
     // First pass: each disk's own speed; later passes: its island's energy.
     for d in disks.iter_mut() {
@@ -485,9 +506,11 @@ fn classify<V: Vector>(
     let mut meets = vec![false; n];
     let mut held = vec![false; n];
     let mut awake = vec![false; n];
+    let mut soft = vec![false; n];
     for k in 0..n {
         let root = find(parent, k) as usize;
         size[root] += 1;
+        soft[root] |= !disks[k].elastic;
         held[root] |= held_disk[k];
         meets[root] |= closing[k];
         awake[root] |= !disks[k].asleep;
@@ -507,6 +530,8 @@ fn classify<V: Vector>(
             index[root] = list.len() as u32;
             let regime = if held[root] {
                 Regime::Resting
+            } else if meets[root] && soft[root] {
+                Regime::Clump
             } else if meets[root] {
                 Regime::Impact
             } else {

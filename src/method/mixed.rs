@@ -1,5 +1,6 @@
 //! A step of `auto` that takes two methods at once, on islands that cannot meet within it (see
-//! [`super::islands`]): the Pop-step group (islands at rest, solved, with the solve's sleepers)
+//! [`super::islands`]): the Pop-step group (islands at rest and inelastic clumps, solved, with
+//! the solve's sleepers)
 //! and the event group (islands of impacts in flight, and islands in free flight, which would
 //! otherwise cut the solve into substeps for their speed and keep it awake).
 //!
@@ -31,7 +32,7 @@ pub(crate) const NO_GROUP: u8 = u8::MAX;
 /// (beside islands at rest, whose solve they would otherwise cut into substeps and keep awake).
 pub(crate) fn group_of(regime: Regime, free_flies: bool) -> u8 {
     match regime {
-        Regime::Resting => POP_GROUP,
+        Regime::Resting | Regime::Clump => POP_GROUP,
         Regime::Free if !free_flies => POP_GROUP,
         Regime::Free | Regime::Impact => EVENT_GROUP,
     }
@@ -87,7 +88,7 @@ pub(crate) fn show<V: Vector>(state: &mut State<V>, hidden: &mut Vec<u32>) {
 pub struct IslandSummary {
     /// All islands.
     pub islands: usize,
-    /// Per regime present (resting, impact, free, in that order).
+    /// Per regime present (resting, clump, impact, free, in that order).
     pub parts: Vec<IslandPart>,
     /// Sleepers in no island (stepped by the solve, which keeps them still).
     pub asleep: usize,
@@ -116,7 +117,7 @@ impl IslandSummary {
         free_flies: bool,
     ) -> IslandSummary {
         let mut parts: Vec<IslandPart> = Vec::new();
-        for regime in [Regime::Resting, Regime::Impact, Regime::Free] {
+        for regime in [Regime::Resting, Regime::Clump, Regime::Impact, Regime::Free] {
             let (mut count, mut critters) = (0, 0);
             for island in islands.list.iter().filter(|i| i.regime == regime) {
                 count += 1;

@@ -138,44 +138,70 @@ impl<V: Vector> MethodState<V> {
         }
         // Something fast meets something thin: the swept step flies the whole scene's impacts
         // in time order already, its resting contacts included, and islands would add nothing.
-        let whole = self.plan_whole(state);
-        if whole.method == Method::Swept {
+        let whole = (self.plan_whole(state), self.auto_choice);
+        if whole.0.method == Method::Swept {
             self.auto_islands = None;
-            return Some(whole);
+            return Some(whole.0);
         }
         // Sleepers the update hooks moved wake now, as the step would wake them, so that the
         // partition takes only true sleepers as still.
         if self.sleep.count() > 0 {
             self.sleep.check(state.critters.slot_slice());
         }
+        if self.sleep.count() > 0 && self.all_asleep(state) {
+            // Nothing to cut, and no partition to pay for.
+            self.auto_islands = None;
+            return Some(whole.0);
+        }
         let found = islands::partition(state, self.sleep.still());
-        let r = self.plan_found(state, &found);
+        let r = self.plan_found(state, &found, whole);
         match r {
             // Sleepers keep still only under a solve: otherwise they are disks like any other.
             Some(plan) if self.sleep.count() > 0 && !matches!(plan.method, Method::Solve(_)) => {
                 let found = islands::partition(state, &[]);
-                self.plan_found(state, &found)
+                self.plan_found(state, &found, whole)
             }
             plan => plan,
         }
     }
 
-    /// `auto`'s plan for the islands `found`: with no island of impacts and none at rest beside
-    /// free ones, the whole scene's choice; with none at rest, `event` for all; otherwise a
-    /// mixed step, the islands at rest solved (the whole scene's choice for them) and the
-    /// islands of impacts and in free flight flown by `event`.
-    fn plan_found(&mut self, state: &mut State<V>, found: &islands::Islands) -> Option<Plan> {
+    /// `auto`'s plan for the islands `found`: with no island of impacts and none solved (at
+    /// rest, or an inelastic clump) beside free ones, the whole scene's choice; with none
+    /// solved, `event` for all; otherwise a mixed step, the solved islands taking the whole
+    /// scene's choice for them and the islands of impacts and in free flight `event`.
+    /// True when every live critter that may move sleeps.
+    fn all_asleep(&self, state: &State<V>) -> bool {
+        let mut slots = state.critters.slot_slice().iter().enumerate();
+        slots.all(|(i, c)| {
+            c.as_ref()
+                .is_none_or(|c| !c.alive || c.is_wall() || c.fixed || self.sleep.asleep(i))
+        })
+    }
+
+    /// `whole` is the whole scene's plan and choice.
+    fn plan_found(
+        &mut self,
+        state: &mut State<V>,
+        found: &islands::Islands,
+        whole: (Plan, Option<(Method, Why)>),
+    ) -> Option<Plan> {
         use islands::Regime;
         let has = |r: Regime| found.list.iter().any(|i| i.regime == r);
-        let resting = has(Regime::Resting) || found.of_slot.contains(&islands::ASLEEP);
+        let solved =
+            has(Regime::Resting) || has(Regime::Clump) || found.of_slot.contains(&islands::ASLEEP);
         let (impact, free) = (has(Regime::Impact), has(Regime::Free));
-        if !(impact || resting && free) {
+        if !(impact || solved && free) {
             // Everything rests, or flies free with nothing at rest: as without islands.
-            let plan = self.plan_whole(state);
-            self.auto_islands = Some(IslandSummary::of(found, plan.method, Method::Event, false));
-            return Some(plan);
+            self.auto_choice = whole.1;
+            self.auto_islands = Some(IslandSummary::of(
+                found,
+                whole.0.method,
+                Method::Event,
+                false,
+            ));
+            return Some(whole.0);
         }
-        if !resting {
+        if !solved {
             let critters = found.list.iter().map(|i| i.size).sum();
             let why = Why::Impacts {
                 islands: found.list.len(),

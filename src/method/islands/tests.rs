@@ -73,6 +73,7 @@ fn brute_force(state: &State<DVec2>) -> Vec<Vec<u32>> {
                     inv_mass: c.inv_mass(),
                     reach: reaches[a],
                     asleep: false,
+                    elastic: true,
                 };
                 held[label[a]] |= supported(&state.topo, &supports, &d, RESTING_STEPS * g * dt);
                 for b in 0..n {
