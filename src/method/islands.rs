@@ -1,5 +1,5 @@
 //! Islands for `auto`: the live disks cut into groups that cannot meet within the coming step,
-//! each with the regime that decides its method ([`partition`]).
+//! each with the regime that decides its method (`partition`).
 //!
 //! **Own reach first.** A free disk moves in a step at most `(v + 2|g| dt) dt` at its own speed
 //! `v` (gravity adds `|g| dt` to a speed over the step, twice for a bounce off a support). Disks
