@@ -902,9 +902,10 @@ fn auto_cuts_a_fast_falling_heap_into_solved_substeps() {
 /// `auto` solves under gravity (`src/method/auto.rs`): a pile is solved by `solve:8` and falls
 /// asleep, where the discrete step would let a deep pile sink
 /// (`docs/stability.md`); without gravity it never solves; and a critter fast enough to tunnel
-/// makes it sweep, where `solve:8` itself lets the bullet through the wall.
+/// through the solve's substeps is flown after the solve as a bullet (alone, it makes the step
+/// swept), where `solve:8` itself lets the bullet through the wall.
 #[test]
-fn auto_solves_resting_piles_under_gravity_but_sweeps_a_bullet_and_never_solves_without_it() {
+fn auto_solves_resting_piles_under_gravity_but_flies_a_bullet_and_never_solves_without_it() {
     // The deep pile of the stability table: discrete sinks more than a radius (asserted above);
     // auto holds it to a tenth of a radius, as solve:8 does.
     let deep = stress(STRESS, "deep pile");
@@ -926,7 +927,7 @@ fn auto_solves_resting_piles_under_gravity_but_sweeps_a_bullet_and_never_solves_
     // A bullet at 100 towards the 0.2-thick wall: 1.67 per step, eleven times what would carry
     // its centre past the wall's mid-plane (its radius and half the wall, 0.15). Its third step
     // ends at x = 10.15, past the mid-plane: fixed solve:8 pushes it out on the far side, as
-    // discrete does; auto sweeps those steps and it bounces.
+    // discrete does; auto solves the pile and flies the bullet after it, and it bounces.
     for (method, passes) in [(Method::Solve(8), true), (Method::Auto, false)] {
         let (mut w, bullet) = pile_and_bullet(method, 100.0);
         let mut furthest: f64 = 0.0;
@@ -940,8 +941,21 @@ fn auto_solves_resting_piles_under_gravity_but_sweeps_a_bullet_and_never_solves_
             "{method}: the bullet reached x = {furthest}"
         );
     }
-    let (mut w, _) = pile_and_bullet(Method::Auto, 100.0);
+    let (mut w, bullet) = pile_and_bullet(Method::Auto, 100.0);
     w.run(3).unwrap();
+    assert_eq!(chose(&w), Some(Method::Solve(8)));
+    assert_eq!(w.auto_islands().map(|i| i.bullets), Some(1));
+    // Alone, the bullet is all there is to step: the step is swept whole.
+    let ids: Vec<_> = w
+        .critters()
+        .iter()
+        .filter(|c| !c.is_wall() && c.id() != bullet)
+        .map(|c| c.id())
+        .collect();
+    for id in ids {
+        w.remove(id).unwrap();
+    }
+    w.step().unwrap();
     assert_eq!(chose(&w), Some(Method::Swept));
 
     // Without gravity the same touching rows are never solved.

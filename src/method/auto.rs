@@ -8,9 +8,11 @@
 //!   [`AUTO_MOST_SWEEPS`] ([`Sweeps::ByDepth`]); its islands at rest sleep. So that nothing
 //!   tunnels, the solved step is cut into as many substeps as keep every critter under
 //!   [`SOLVE_FRACTION`] of what would carry it through a wall or a disk (`tunnel_fraction`),
-//!   up to [`MOST_SOLVE_SUBSTEPS`]. A step that would need more is swept (resting contacts are
-//!   the event step's worst case); in a sparse scene (disks cover less than [`SPARSE`] of the
-//!   box) only the critters that are fast or may meet something along their line predict.
+//!   up to [`MOST_SOLVE_SUBSTEPS`]. Critters that would need more are bullets: while they are
+//!   few, the step is taken without them and they are flown after it (`method::bullets`);
+//!   otherwise the step is swept (resting contacts are the event step's worst case), and in a
+//!   sparse scene (disks cover less than [`SPARSE`] of the box) only the critters that are
+//!   fast or may meet something along their line predict.
 //! * **Without gravity** nothing rests, and a solve would spread a Newton's cradle's momentum
 //!   over its balls, so the step is never solved. It is `event`, exact, with its flight kept
 //!   from step to step so that a step pays for its events, not for predicting everyone anew.
@@ -191,7 +193,8 @@ impl std::fmt::Display for Why {
 /// `tunnel_fraction` under this.
 pub const SOLVE_FRACTION: f64 = 0.5;
 
-/// The most substeps of a solved step; a step that would need more is swept.
+/// The most substeps of a solved step; critters that would need more are bullets
+/// (`method::bullets`), or the step is swept.
 pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 
 /// The largest fraction, over the critters, of what would carry a critter through something in

@@ -382,9 +382,63 @@ fn link_pairs<V: Vector>(
             }
         }
     }
-    for &a in &wide {
-        for b in 0..n {
-            if b != a && (!is_wide(b) || b > a) {
+    // A wide disk meets a narrow one only within its own span and half the narrowest cell: it
+    // walks the cells of that box when they are fewer than the disks, else tests them all.
+    let mut seen = Vec::new();
+    for (i, &a) in wide.iter().enumerate() {
+        for &b in &wide[i + 1..] {
+            test(a, b, parent, &mut first);
+        }
+        let da = &disks[a];
+        let span = da.radius + da.reach + 0.5 * narrowest;
+        let mut lo = [0i64; 3];
+        let mut hi = [0i64; 3];
+        let mut count = 1.0f64;
+        for ax in 0..V::DIM {
+            let at = |x: f64| ((x - topo.min.get(ax)) / cell_side[ax]).floor();
+            let (l, h) = (at(da.pos.get(ax) - span), at(da.pos.get(ax) + span));
+            let m = dims[ax] as f64;
+            // Wrapped, a box as wide as the grid covers it all; unwrapped, it is clamped.
+            let (l, h) = if wraps {
+                if h - l + 1.0 >= m {
+                    (0.0, m - 1.0)
+                } else {
+                    (l, h)
+                }
+            } else {
+                (l.max(0.0), h.min(m - 1.0))
+            };
+            if l.is_nan() || h.is_nan() || l > h {
+                count = f64::INFINITY; // NaN (never: the grid is finite) or empty
+                break;
+            }
+            count *= h - l + 1.0;
+            (lo[ax], hi[ax]) = (l as i64, h as i64);
+        }
+        if count > n as f64 {
+            for b in 0..n {
+                if !is_wide(b) {
+                    test(a, b, parent, &mut first);
+                }
+            }
+            continue;
+        }
+        seen.clear();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let mut c = [0usize; 3];
+                    for (ax, v) in [x, y, z].into_iter().enumerate().take(V::DIM) {
+                        c[ax] = v.rem_euclid(dims[ax] as i64) as usize;
+                    }
+                    seen.push(key(c));
+                }
+            }
+        }
+        seen.sort_unstable();
+        seen.dedup();
+        for &k in &seen {
+            for &b in &order[start[k]..start[k + 1]] {
                 test(a, b, parent, &mut first);
             }
         }

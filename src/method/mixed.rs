@@ -92,6 +92,8 @@ pub struct IslandSummary {
     pub parts: Vec<IslandPart>,
     /// Sleepers in no island (stepped by the solve, which keeps them still).
     pub asleep: usize,
+    /// Bullets flown after the step (see `method::bullets`), in no island.
+    pub bullets: usize,
 }
 
 /// The islands of one regime.
@@ -140,6 +142,7 @@ impl IslandSummary {
             islands: islands.list.len(),
             parts,
             asleep: islands.of_slot.iter().filter(|&&i| i == ASLEEP).count(),
+            bullets: 0,
         }
     }
 
@@ -172,9 +175,18 @@ impl std::fmt::Display for IslandSummary {
                 p.regime.describe()
             )?;
         }
+        let mut sep = if self.parts.is_empty() { ":" } else { ";" };
         if self.asleep > 0 {
-            let sep = if self.parts.is_empty() { ":" } else { ";" };
             write!(f, "{sep} {} asleep", self.asleep)?;
+            sep = ";";
+        }
+        if self.bullets > 0 {
+            write!(
+                f,
+                "{sep} {} {} too fast for the solve's substeps, flown after it against the rest",
+                self.bullets,
+                plural(self.bullets, "bullet", "bullets")
+            )?;
         }
         Ok(())
     }

@@ -21,6 +21,7 @@
 //! formulas.
 
 pub mod auto;
+pub mod bullets;
 pub(crate) mod discrete;
 pub(crate) mod event;
 pub(crate) mod flight;

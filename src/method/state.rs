@@ -7,7 +7,7 @@ use super::discrete::{self, Respond};
 use super::islands;
 use super::mixed::{self, IslandSummary, EVENT_GROUP, POP_GROUP};
 use super::solve::{self, Sweeps};
-use super::{event, flight, sleep::Sleep, swept, Method};
+use super::{bullets, event, flight, sleep::Sleep, swept, Method};
 use crate::border::Topology;
 use crate::broad_phase::BroadPhase;
 use crate::critter::Critter;
@@ -32,6 +32,9 @@ pub(crate) struct MethodState<V: Vector> {
     /// each group keeps its broad phase's list, the event group's here.
     last_groups: Vec<u8>,
     event_broad: Option<BroadPhase<V>>,
+    /// `auto`'s bullets of the coming step (see `bullets`), by slot, and marked by slot.
+    bullets: Vec<u32>,
+    is_bullet: Vec<bool>,
     pub(super) flight: flight::Scratch<V>,
     solve: solve::Scratch<V>,
     sleep: Sleep<V>,
@@ -52,6 +55,8 @@ pub(crate) struct Plan {
     /// `auto` steps two groups of islands apart: the fields above are the Pop-step group's
     /// plan, and the event group takes `event` (see `mixed`).
     mixed: bool,
+    /// `auto` takes the step without its bullets, then flies them (see `bullets`).
+    bullets: bool,
 }
 
 impl<V: Vector> MethodState<V> {
@@ -64,6 +69,8 @@ impl<V: Vector> MethodState<V> {
             hidden: Vec::new(),
             last_groups: Vec::new(),
             event_broad: None,
+            bullets: Vec::new(),
+            is_bullet: Vec::new(),
             flight: Default::default(),
             solve: Default::default(),
             sleep: Sleep::new(sleep),
@@ -105,6 +112,7 @@ impl<V: Vector> MethodState<V> {
                 substeps: 1,
                 sweeps: None,
                 mixed: false,
+                bullets: false,
             },
         }
     }
@@ -119,12 +127,14 @@ impl<V: Vector> MethodState<V> {
             substeps: choice.substeps,
             sweeps: Some(choice.sweeps),
             mixed: false,
+            bullets: false,
         }
     }
 
     /// `auto`'s plan by islands (see `islands`), under gravity; `None` where islands do not
-    /// apply (no gravity, where nothing rests; a fixed critter that moves). A whole scene that
-    /// needs the swept step takes it whole.
+    /// apply (no gravity, where nothing rests; a fixed critter that moves). A scene that needs
+    /// the swept step for a few bullets is planned without them, and flies them after; one that
+    /// needs it for more takes it whole.
     fn plan_islands(&mut self, state: &mut State<V>) -> Option<Plan> {
         if state.gravity == V::zero() {
             return None;
@@ -139,10 +149,50 @@ impl<V: Vector> MethodState<V> {
         // Something fast meets something thin: the swept step flies the whole scene's impacts
         // in time order already, its resting contacts included, and islands would add nothing.
         let whole = (self.plan_whole(state), self.auto_choice);
-        if whole.0.method == Method::Swept {
+        if whole.0.method != Method::Swept {
+            self.bullets.clear();
+            return Some(self.plan_settled(state, whole));
+        }
+        if !bullets::find(state, &mut self.bullets) {
             self.auto_islands = None;
             return Some(whole.0);
         }
+        self.hide_bullets(state);
+        let whole = (self.plan_whole(state), self.auto_choice);
+        let mut plan = self.plan_settled(state, whole);
+        self.show_bullets(state);
+        plan.bullets = true;
+        let summary = self.auto_islands.get_or_insert_with(Default::default);
+        summary.bullets = self.bullets.len();
+        Some(plan)
+    }
+
+    /// Marks `auto`'s bullets not alive (and by slot in `is_bullet`).
+    fn hide_bullets(&mut self, state: &mut State<V>) {
+        let slots = state.critters.slots_mut_moving();
+        self.is_bullet.clear();
+        self.is_bullet.resize(slots.len(), false);
+        for &b in &self.bullets {
+            if let Some(Some(c)) = slots.get_mut(b as usize) {
+                c.alive = false;
+                self.is_bullet[b as usize] = true;
+            }
+        }
+    }
+
+    /// Shows `auto`'s bullets again.
+    fn show_bullets(&mut self, state: &mut State<V>) {
+        let slots = state.critters.slots_mut_moving();
+        for &b in &self.bullets {
+            if let Some(Some(c)) = slots.get_mut(b as usize) {
+                c.alive = true;
+            }
+        }
+    }
+
+    /// `auto`'s plan by islands for a scene that needs no swept step (`whole` is its plan and
+    /// choice for the whole scene).
+    fn plan_settled(&mut self, state: &mut State<V>, whole: (Plan, Option<(Method, Why)>)) -> Plan {
         // Sleepers the update hooks moved wake now, as the step would wake them, so that the
         // partition takes only true sleepers as still.
         if self.sleep.count() > 0 {
@@ -151,18 +201,16 @@ impl<V: Vector> MethodState<V> {
         if self.sleep.count() > 0 && self.all_asleep(state) {
             // Nothing to cut, and no partition to pay for.
             self.auto_islands = None;
-            return Some(whole.0);
+            return whole.0;
         }
         let found = islands::partition(state, self.sleep.still());
-        let r = self.plan_found(state, &found, whole);
-        match r {
+        let plan = self.plan_found(state, &found, whole);
+        if self.sleep.count() > 0 && !matches!(plan.method, Method::Solve(_)) {
             // Sleepers keep still only under a solve: otherwise they are disks like any other.
-            Some(plan) if self.sleep.count() > 0 && !matches!(plan.method, Method::Solve(_)) => {
-                let found = islands::partition(state, &[]);
-                self.plan_found(state, &found, whole)
-            }
-            plan => plan,
+            let found = islands::partition(state, &[]);
+            return self.plan_found(state, &found, whole);
         }
+        plan
     }
 
     /// `auto`'s plan for the islands `found`: with no island of impacts and none solved (at
@@ -184,7 +232,7 @@ impl<V: Vector> MethodState<V> {
         state: &mut State<V>,
         found: &islands::Islands,
         whole: (Plan, Option<(Method, Why)>),
-    ) -> Option<Plan> {
+    ) -> Plan {
         use islands::Regime;
         let has = |r: Regime| found.list.iter().any(|i| i.regime == r);
         let solved =
@@ -199,7 +247,7 @@ impl<V: Vector> MethodState<V> {
                 Method::Event,
                 false,
             ));
-            return Some(whole.0);
+            return whole.0;
         }
         if !solved {
             let critters = found.list.iter().map(|i| i.size).sum();
@@ -209,13 +257,14 @@ impl<V: Vector> MethodState<V> {
             };
             self.auto_choice = Some((Method::Event, why));
             self.auto_islands = Some(IslandSummary::of(found, Method::Event, Method::Event, true));
-            return Some(Plan {
+            return Plan {
                 method: Method::Event,
                 per_critter: false,
                 substeps: 1,
                 sweeps: None,
                 mixed: false,
-            });
+                bullets: false,
+            };
         }
         mixed::groups_by_slot(found, true, &mut self.groups);
         // The Pop-step group's plan, measured on its own critters.
@@ -224,19 +273,39 @@ impl<V: Vector> MethodState<V> {
         mixed::show(state, &mut self.hidden);
         plan.mixed = true;
         self.auto_islands = Some(IslandSummary::of(found, plan.method, Method::Event, true));
-        Some(plan)
+        plan
     }
 
     /// True when `plan` keeps no state by slot between steps, so the critters may be laid out
     /// anew in memory (see `world::layout`).
     pub(crate) fn allows_layout(&self, plan: &Plan) -> bool {
         let slot_free = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
-        slot_free(self.method) && slot_free(plan.method) && !plan.mixed
+        slot_free(self.method) && slot_free(plan.method) && !plan.mixed && !plan.bullets
     }
 
     /// Moves and collides the critters over the step under `plan` (after the update hooks,
     /// before the lifecycle).
     pub(crate) fn step(
+        &mut self,
+        plan: Plan,
+        state: &mut State<V>,
+        pairs: &mut Pairs<V>,
+        stats: &mut StepStats,
+    ) -> Result<(), Error> {
+        if !plan.bullets {
+            return self.step_groups(plan, state, pairs, stats);
+        }
+        self.hide_bullets(state);
+        let result = self.step_groups(plan, state, pairs, stats);
+        self.show_bullets(state);
+        state.neighbours.invalidate();
+        result?;
+        bullets::fly(state, &self.bullets, &self.is_bullet, stats)
+    }
+
+    /// [`Self::step`] without the bullets: the whole scene under one method, or each group
+    /// under its own.
+    fn step_groups(
         &mut self,
         plan: Plan,
         state: &mut State<V>,
@@ -267,6 +336,7 @@ impl<V: Vector> MethodState<V> {
             substeps: 1,
             sweeps: None,
             mixed: false,
+            bullets: false,
         };
         let mut groups = std::mem::take(&mut self.groups);
         let mut event_broad = self

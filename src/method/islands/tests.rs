@@ -129,14 +129,16 @@ fn brute_force(state: &State<DVec2>) -> Vec<Vec<u32>> {
     islands
 }
 
-/// A seeded scatter of `n` disks of radii 0.1 to 0.3 and speeds up to `speed` in a 10 x 10 box.
-fn scatter(n: usize, speed: f64, seed: u64) -> World<DVec2> {
-    let mut w = World::new(
-        WorldConfig::new(DVec2::ZERO, DVec2::splat(10.0))
-            .dt(1.0 / 60.0)
-            .gravity(DVec2::new(0.0, -9.81)),
-    )
-    .expect("world");
+/// A seeded scatter of `n` disks of radii 0.1 to 0.3 and speeds up to `speed` in a 10 x 10 box
+/// (whose border wraps when `wrap`).
+fn scatter(n: usize, speed: f64, seed: u64, wrap: bool) -> World<DVec2> {
+    let mut config = WorldConfig::new(DVec2::ZERO, DVec2::splat(10.0))
+        .dt(1.0 / 60.0)
+        .gravity(DVec2::new(0.0, -9.81));
+    if wrap {
+        config = config.border(crate::border::Border::Wrap);
+    }
+    let mut w = World::new(config).expect("world");
     let mut state = seed;
     let mut rand = move || {
         state = state
@@ -157,8 +159,18 @@ fn scatter(n: usize, speed: f64, seed: u64) -> World<DVec2> {
 fn islands_agree_with_brute_force_on_random_scenes() {
     let mut joined = 0;
     for seed in 0..12u64 {
-        for (n, speed) in [(40, 0.5), (150, 2.0), (300, 0.1), (80, 20.0)] {
-            let w = scatter(n, speed, seed + 1);
+        // Fast disks are wide (tested over the cells of their boxes, or against all), on a
+        // border that wraps too.
+        let cases = [
+            (40, 0.5, false),
+            (150, 2.0, false),
+            (300, 0.1, false),
+            (80, 20.0, false),
+            (200, 8.0, true),
+            (120, 60.0, true),
+        ];
+        for (n, speed, wrap) in cases {
+            let w = scatter(n, speed, seed + 1, wrap);
             let found = partition(&w.state, &[]);
             let mut mine: Vec<Vec<u32>> = vec![Vec::new(); found.list.len()];
             for (slot, &i) in found.of_slot.iter().enumerate() {
@@ -167,7 +179,10 @@ fn islands_agree_with_brute_force_on_random_scenes() {
                 }
             }
             let theirs = brute_force(&w.state);
-            assert_eq!(mine, theirs, "seed {seed}, {n} disks at up to {speed}");
+            assert_eq!(
+                mine, theirs,
+                "seed {seed}, {n} disks at up to {speed}, wrap {wrap}"
+            );
             for (island, listed) in mine.iter().zip(&found.list) {
                 assert_eq!(listed.first, island[0]);
                 assert_eq!(listed.size, island.len());
