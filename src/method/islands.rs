@@ -4,7 +4,7 @@
 //! **Own reach first.** A free disk moves in a step at most `(v + 2|g| dt) dt` at its own speed
 //! `v` (gravity adds `|g| dt` to a speed over the step, twice for a bounce off a support). Disks
 //! whose gap is within their two reaches are joined (a hashed grid, about two buckets per
-//! disk; the few fastest or largest disks are tested against all). At these reaches each
+//! disk; the few fastest or largest disks walk the cells their reach spans). At these reaches each
 //! island gets its regime ([`Regime`]), under gravity:
 //! - *resting*: a disk of it is within reach of a wall, a fixed critter, a bouncing edge or a
 //!   sleeper of `solve:n` and approaches it slower than [`RESTING_STEPS`] steps of gravity: it
@@ -277,9 +277,9 @@ fn link_pairs<V: Vector>(
     let cells = 1usize << bits;
     // A cell's bucket (Fibonacci hashing of its index); cells that share one are both
     // visited, which only repeats tests.
+    let bucket = |index: u64| (index.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize;
     let key = |c: [usize; 3]| {
-        let index = ((c[2] as u64 * dims[1] as u64) + c[1] as u64) * dims[0] as u64 + c[0] as u64;
-        (index.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize
+        bucket(((c[2] as u64 * dims[1] as u64) + c[1] as u64) * dims[0] as u64 + c[0] as u64)
     };
     let wide: Vec<usize> = (0..n)
         .filter(|&k| disks[k].radius + disks[k].reach > 0.5 * narrowest)
@@ -332,47 +332,40 @@ fn link_pairs<V: Vector>(
             }
         };
     let wraps = topo.wraps();
+    // The cells around cell `c` along axis `ax`, each listed once (a wrapped axis of fewer than
+    // three cells repeats them). Distinct cells that share a bucket only repeat tests.
+    let around = |c: usize, ax: usize| {
+        let (mut out, mut len) = ([0usize; 3], 0);
+        let m = dims[ax] as i64;
+        for v in [c as i64 - 1, c as i64, c as i64 + 1] {
+            let v = if (0..m).contains(&v) {
+                v as usize
+            } else if wraps {
+                v.rem_euclid(m) as usize
+            } else {
+                continue;
+            };
+            if !out[..len].contains(&v) {
+                out[len] = v;
+                len += 1;
+            }
+        }
+        (out, len)
+    };
     // Awake disks look around their cells; sleepers are only looked at.
     for (a, disk) in disks.iter().enumerate() {
-        if is_wide(a) || disk.asleep {
+        if cell_of[a] == usize::MAX || disk.asleep {
             continue;
         }
         let ca = coord(disk.pos);
-        let mut lo = [0i64; 3];
-        let mut hi = [0i64; 3];
-        for ax in 0..3 {
-            if ax < V::DIM {
-                lo[ax] = ca[ax] as i64 - 1;
-                hi[ax] = ca[ax] as i64 + 1;
-            }
-        }
-        // Few cells along an axis repeat a neighbour: each cell is visited once.
-        let mut seen = [usize::MAX; 27];
-        let mut seen_count = 0;
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    let mut c = [0usize; 3];
-                    let mut inside = true;
-                    for (ax, v) in [x, y, z].into_iter().enumerate() {
-                        let m = dims[ax] as i64;
-                        if (0..m).contains(&v) {
-                            c[ax] = v as usize;
-                        } else if wraps && ax < V::DIM {
-                            c[ax] = v.rem_euclid(m) as usize;
-                        } else {
-                            inside = false;
-                        }
-                    }
-                    if !inside {
-                        continue;
-                    }
-                    let k = key(c);
-                    if seen[..seen_count].contains(&k) {
-                        continue;
-                    }
-                    seen[seen_count] = k;
-                    seen_count += 1;
+        let (xs, nx) = around(ca[0], 0);
+        let (ys, ny) = around(ca[1], 1);
+        let (zs, nz) = around(ca[2], 2);
+        for &z in &zs[..nz] {
+            for &y in &ys[..ny] {
+                let row = (z as u64 * dims[1] as u64 + y as u64) * dims[0] as u64;
+                for &x in &xs[..nx] {
+                    let k = bucket(row + x as u64);
                     for &b in &order[start[k]..start[k + 1]] {
                         if b > a || disks[b].asleep {
                             test(a, b, parent, &mut first);
