@@ -56,27 +56,35 @@ macro_rules! critter_setter {
 fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: bool) -> Res<()> {
     let prop = to_prop(value)?;
     with_env!(host, env => {
-        let kind = match env.critter(id) {
-            Some(c) => env.kinds().name(c.kind()).to_string(),
-            None => return Err(gone(id)),
+        let Some(c) = env.critter_mut(id) else {
+            return if env.critter(id).is_some() {
+                fail("critters are read-only in collides_with")
+            } else {
+                Err(gone(id))
+            };
         };
-        match env.critter_mut(id) {
-            Some(c) if create || c.props().contains_key(name) => {
-                c.props_mut().insert(name.to_string(), prop);
-                Ok(())
-            }
-            Some(_) => fail_hint(
-                format!(
-                    "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
-                     health, restitution, priority, fixed)"
-                ),
-                format!(
-                    "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
-                     set_prop(\"{name}\", value)"
-                ),
-            ),
-            None => fail("critters are read-only in collides_with"),
+        // An update hook sets properties of every critter every step: no allocation when the
+        // property exists.
+        if let Some(slot) = c.props_mut().get_mut(name) {
+            *slot = prop;
+            return Ok(());
         }
+        if create {
+            c.props_mut().insert(name.to_string(), prop);
+            return Ok(());
+        }
+        let kind = c.kind();
+        let kind = env.kinds().name(kind);
+        fail_hint(
+            format!(
+                "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
+                 health, restitution, priority, fixed)"
+            ),
+            format!(
+                "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
+                 set_prop(\"{name}\", value)"
+            ),
+        )
     })
 }
 
