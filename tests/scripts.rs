@@ -1305,3 +1305,30 @@ spawn("tagger", #{ pos: vec(5, 5) });
     assert_eq!(prop(w, id, "seen"), PropValue::Text("start".into()));
     assert_eq!(prop(w, id, "tag"), PropValue::Text("changed".into()));
 }
+
+/// A scene may name a kind by its file's path: `spawn`, `scatter` and `load_kind` load the file
+/// and use the kind it defines (named after the file), so a spawn by path makes critters of
+/// that kind, and a second spawn by the same path reuses it.
+#[test]
+fn a_scene_spawns_a_kind_named_by_its_path() {
+    let sandbox = Sandbox::new("spawn_by_path");
+    let path = sandbox.kind("sparky", "defaults(#{ radius: 0.25 });\n");
+    let path = path.display().to_string();
+    let scene = sandbox.load(&format!(
+        r#"
+let w = world(#{{ dim: 2, size: vec(20, 20), dt: 0.01, seed: 1 }});
+load_kind("{path}");
+spawn("{path}", #{{ pos: vec(2, 2) }});
+spawn("{path}", #{{ pos: vec(6, 2) }});
+w.scatter("{path}", 3, #{{}});
+"#
+    ));
+    let w = w2(&scene);
+    let kinds: Vec<&str> = w
+        .critters()
+        .iter()
+        .map(|c| w.kinds().name(c.kind()))
+        .collect();
+    assert_eq!(kinds, vec!["sparky"; 5]);
+    assert!(w.critters().iter().all(|c| c.radius() == 0.25));
+}

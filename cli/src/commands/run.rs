@@ -151,7 +151,17 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
                 }
             });
         }
-        let outcome = match outcome.with_context(|| format!("scene '{name}', step {step}")) {
+        // A script error names its step already.
+        let names_step =
+            |e: &critterbox::Error| matches!(e, critterbox::Error::Script(s) if s.step.is_some());
+        let outcome = match outcome.map_err(|e| {
+            let context = if names_step(&e) {
+                format!("scene '{name}'")
+            } else {
+                format!("scene '{name}', step {step}")
+            };
+            anyhow::Error::new(e).context(context)
+        }) {
             Ok(outcome) => outcome,
             Err(e) => {
                 // The error goes into the recording, which is closed before it is reported.

@@ -24,15 +24,19 @@ const WORLD_KEYS: &[&str] = &[
     "dim", "size", "min", "border", "gravity", "dt", "seed", "method", "sleep", "steps",
 ];
 
-/// Loads kind `name` into whatever world scripts act on, unless it is there already.
-fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<()> {
+/// Loads kind `name` into whatever world scripts act on, unless it is there already; the
+/// kind's name (a path such as `"kinds/spark.rhai"` names the kind its file defines).
+fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<String> {
     let known = with_env!(host, env => Ok(env.kinds().id(name).is_ok()))?;
     if known {
-        return Ok(());
+        return Ok(name.to_string());
     }
     let rt = host.runtime()?;
     with_env!(host, env => match env.world() {
-        Some(world) => load_into(&rt, world, name).map(|_| ()).map_err(|e| host.carry(e)),
+        Some(world) => match load_into(&rt, world, name) {
+            Ok(id) => Ok(world.kinds().name(id).to_string()),
+            Err(e) => Err(host.carry(e)),
+        },
         None => fail(format!(
             "unknown kind '{name}': kinds are loaded between steps; call load_kind(\"{name}\") in the scene script"
         )),
@@ -193,7 +197,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_fn("world", move |map: Map| make_world(&h, &map));
     let h = host.clone();
     engine.register_fn("load_kind", move |name: &str| -> Res<()> {
-        ensure_kind(&h, name)
+        ensure_kind(&h, name).map(drop)
     });
 
     let h = host.clone();
@@ -309,10 +313,10 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     engine.register_fn(
         "scatter",
         move |_: &mut WorldRef, kind: &str, count: INT, map: Map| -> Res<Array> {
-            ensure_kind(&h, kind)?;
+            let kind = ensure_kind(&h, kind)?;
             let mut out = Array::new();
             for _ in 0..count.max(0) {
-                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, kind, &map))?);
+                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, &kind, &map))?);
             }
             Ok(out)
         },
@@ -365,9 +369,11 @@ fn spawn_syntax(
         ));
     };
     let in_world = with_env!(h, env => Ok(env.world().is_some()))?;
-    if in_world {
-        ensure_kind(h, &kind)?;
-    }
+    let kind = if in_world {
+        ensure_kind(h, &kind)?
+    } else {
+        kind.to_string()
+    };
     let origin = if in_world {
         None
     } else {
@@ -396,12 +402,12 @@ fn spawn_at(
     map: &Map,
     positions: impl Iterator<Item = DVec3>,
 ) -> Res<Array> {
-    ensure_kind(host, kind)?;
+    let kind = ensure_kind(host, kind)?;
     let mut out = Array::new();
     for p in positions {
         let mut m = map.clone();
         m.insert("pos".into(), Dynamic::from(p));
-        out.push(with_env!(host, env => spawn_in(env, host, kind, &m))?);
+        out.push(with_env!(host, env => spawn_in(env, host, &kind, &m))?);
     }
     Ok(out)
 }

@@ -160,6 +160,14 @@ pub(crate) fn unknown_kind_in_step(kind: &str, e: crate::Error) -> Box<rhai::Eva
         crate::Error::UnknownKind { known, .. } => known.clone(),
         _ => String::new(),
     };
+    let path = std::path::Path::new(kind);
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or(kind);
+    if kind.ends_with(".rhai") || kind.contains('/') {
+        return error(format!(
+            "unknown kind '{kind}' (known kinds: {known}){HINT_MARK}inside a step, spawn by the kind's name: \
+             load_kind(\"{kind}\") in the scene, then spawn(\"{stem}\", ...) here",
+        ));
+    }
     error(format!(
         "unknown kind '{kind}' (known kinds: {known}){HINT_MARK}a kind named as a string literal in a kind file loads before the run; \
          a name computed at run time must be loaded first with load_kind(\"{kind}\") in the scene or test",
