@@ -442,6 +442,10 @@ fn link_pairs<V: Vector>(
 /// testing the pairs (joining more is always safe).
 const MOST_PAIRS_TESTED: usize = 1 << 14;
 
+/// Islands of more disks than this have their members sorted along x for the test against
+/// another island.
+const SORTED_MEMBERS: usize = 32;
+
 /// Joins the islands of `parent` that hold two disks within their reaches; true when some
 /// joined. Each island's box (its disks' centres widened by radius and reach) is swept along x
 /// against the others' (a border that does not wrap), so only islands whose boxes meet are
@@ -476,6 +480,25 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
         members[fill[r as usize]] = k;
         fill[r as usize] += 1;
     }
+    // A large island's members sorted along x, with their widest radius and reach: a disk of
+    // another island can be within reach only of the members in a window of x around it.
+    let mut widest = vec![0.0f64; n];
+    for r in (0..n).filter(|&r| count[r + 1] - count[r] > SORTED_MEMBERS) {
+        let own = &mut members[count[r]..count[r + 1]];
+        own.sort_by(|&p, &q| disks[p].pos.get(0).total_cmp(&disks[q].pos.get(0)));
+        widest[r] = own
+            .iter()
+            .map(|&p| disks[p].radius + disks[p].reach)
+            .fold(0.0, f64::max);
+    }
+    let within = |p: usize, q: usize| {
+        let (dp, dq) = (&disks[p], &disks[q]);
+        if dp.asleep && dq.asleep {
+            return false;
+        }
+        let gap = (dq.pos - dp.pos).length() - dp.radius - dq.radius;
+        gap <= dp.reach + dq.reach
+    };
     let mut roots: Vec<usize> = (0..n).filter(|&r| count[r + 1] > count[r]).collect();
     roots.sort_by(|&a, &b| lo[a].get(0).total_cmp(&lo[b].get(0)).then(a.cmp(&b)));
     let meet = |a: usize, b: usize| {
@@ -494,17 +517,27 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
                 &members[count[a]..count[a + 1]],
                 &members[count[b]..count[b + 1]],
             );
+            let (big, small, large) = if da.len() >= db.len() {
+                (da, db, a)
+            } else {
+                (db, da, b)
+            };
             let near = da.len() * db.len() > MOST_PAIRS_TESTED
-                || da.iter().any(|&p| {
-                    db.iter().any(|&q| {
-                        let (dp, dq) = (&disks[p], &disks[q]);
-                        if dp.asleep && dq.asleep {
-                            return false;
-                        }
-                        let gap = (dq.pos - dp.pos).length() - dp.radius - dq.radius;
-                        gap <= dp.reach + dq.reach
+                || if big.len() > SORTED_MEMBERS {
+                    small.iter().any(|&q| {
+                        let x = disks[q].pos.get(0);
+                        // A margin over rounding, so that the window holds every pair within.
+                        let w = disks[q].radius + disks[q].reach + widest[large];
+                        let w = w + 1e-9 * (1.0 + x.abs() + w);
+                        let from = big.partition_point(|&p| disks[p].pos.get(0) < x - w);
+                        big[from..]
+                            .iter()
+                            .take_while(|&&p| disks[p].pos.get(0) <= x + w)
+                            .any(|&p| within(p, q))
                     })
-                });
+                } else {
+                    big.iter().any(|&p| small.iter().any(|&q| within(p, q)))
+                };
             if near {
                 joins.push((a, b));
             }
