@@ -482,8 +482,11 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
     }
     // A large island's members sorted along x, with their widest radius and reach: a disk of
     // another island can be within reach only of the members in a window of x around it.
+    // Islands past `MOST_PAIRS_TESTED` are joined untested and need no order.
     let mut widest = vec![0.0f64; n];
-    for r in (0..n).filter(|&r| count[r + 1] - count[r] > SORTED_MEMBERS) {
+    for r in (0..n)
+        .filter(|&r| (SORTED_MEMBERS + 1..=MOST_PAIRS_TESTED).contains(&(count[r + 1] - count[r])))
+    {
         let own = &mut members[count[r]..count[r + 1]];
         own.sort_by(|&p, &q| disks[p].pos.get(0).total_cmp(&disks[q].pos.get(0)));
         widest[r] = own
