@@ -525,6 +525,14 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
             } else {
                 (db, da, b)
             };
+            // The pair in `a`, `b` order, so each gap rounds as the plain test's does.
+            let in_order = |p: usize, q: usize| {
+                if large == a {
+                    within(p, q)
+                } else {
+                    within(q, p)
+                }
+            };
             let near = da.len() * db.len() > MOST_PAIRS_TESTED
                 || if big.len() > SORTED_MEMBERS {
                     small.iter().any(|&q| {
@@ -536,10 +544,10 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
                         big[from..]
                             .iter()
                             .take_while(|&&p| disks[p].pos.get(0) <= x + w)
-                            .any(|&p| within(p, q))
+                            .any(|&p| in_order(p, q))
                     })
                 } else {
-                    big.iter().any(|&p| small.iter().any(|&q| within(p, q)))
+                    da.iter().any(|&p| db.iter().any(|&q| within(p, q)))
                 };
             if near {
                 joins.push((a, b));
