@@ -135,7 +135,7 @@ pub unsafe fn pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) 
     let k = _mm512_set1_epi64(K as i64);
     // The lanes are kept as words, not as vectors: an array of vectors across the closure
     // was stored to a stack slot the frame had not aligned to 64 bytes (a fault).
-    let mut moving = [0; SETS].map(start_moving);
+    let mut moving = [start_moving(); SETS];
     let mut statics = start_static();
     let mut sums = Sums::new();
     for_each_in_sets(slots, |s, c| {
@@ -166,7 +166,7 @@ pub unsafe fn moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
         return portable_moving_pass(slots);
     };
     let k = _mm512_set1_epi64(K as i64);
-    let mut moving = [0; SETS].map(start_moving);
+    let mut moving = [start_moving(); SETS];
     let mut sums = Sums::new();
     for_each_in_sets(slots, |s, c| {
         sums.add(s, c);

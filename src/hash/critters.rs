@@ -65,8 +65,8 @@ const fn start() -> [u64; LANES] {
     out
 }
 
-/// Eight starting lanes, from lane `first` of [`START`]: moving set `s` starts at `s * MOVING`,
-/// the static set at `SETS * MOVING`.
+/// Eight starting lanes, from lane `first` of [`START`]: the moving sets start at 0, the static
+/// set at `SETS * MOVING` (the lanes between are not used).
 const fn start_set(first: usize) -> [u64; MOVING] {
     let mut out = [0u64; MOVING];
     let mut j = 0;
@@ -77,9 +77,10 @@ const fn start_set(first: usize) -> [u64; MOVING] {
     out
 }
 
-/// The starting lanes of moving set `s`.
-pub(super) const fn start_moving(s: usize) -> [u64; MOVING] {
-    start_set(s * MOVING)
+/// The starting lanes of every moving set: the sets differ by the critters they take, not by
+/// where they start.
+pub(super) const fn start_moving() -> [u64; MOVING] {
+    start_set(0)
 }
 
 /// The starting lanes of the static words (as many as the moving ones: one register each).
@@ -235,7 +236,7 @@ pub fn pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass
 
 /// [`pass`] one lane at a time, on any CPU.
 pub fn portable_pass<V: Vector>(slots: InIdOrder<'_, V>, props: &mut StateHasher) -> Pass<V> {
-    let mut moving = [0; SETS].map(start_moving);
+    let mut moving = [start_moving(); SETS];
     let mut statics = start_static();
     let mut sums = Sums::new();
     for_each_in_sets(slots, |s, c| {
@@ -309,7 +310,7 @@ pub fn moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
 
 /// [`moving_pass`] one lane at a time, on any CPU.
 pub fn portable_moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V> {
-    let mut lanes = [0; SETS].map(start_moving);
+    let mut lanes = [start_moving(); SETS];
     let mut sums = Sums::new();
     for_each_in_sets(slots, |s, c| {
         sums.add(s, c);
