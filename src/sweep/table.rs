@@ -89,7 +89,14 @@ impl Table {
                     (None, None) => String::new(),
                 };
                 row.push(outcome);
-                row.push(opt(r.error.clone()));
+                // One line per row, for line-based tools; the result file keeps the full text.
+                row.push(opt(r.error.as_ref().map(|e| {
+                    e.lines()
+                        .map(str::trim)
+                        .filter(|l| !l.is_empty())
+                        .collect::<Vec<_>>()
+                        .join(" / ")
+                })));
                 for c in &figures {
                     row.push(r.summary.as_ref().map_or(String::new(), |s| figure(s, c)));
                 }
