@@ -56,7 +56,7 @@ impl SweepFile {
         axes.push(over(&a.seed, |p, v| p.seed = Some(v)));
         let mut runs = vec![base];
         for axis in &axes {
-            runs = runs.iter().flat_map(|p| axis(p)).collect();
+            runs = runs.iter().flat_map(axis).collect();
         }
         runs
     }

@@ -252,7 +252,8 @@ impl SweepFile {
                 "n works on built-in scenes; a scene script sets its own counts (vary a constant with [axes.set])".into(),
             ));
         }
-        if !self.is_script() && !(self.sets.is_empty() && a.sets.is_empty()) {
+        let sets_any = !self.sets.is_empty() || !a.sets.is_empty();
+        if !self.is_script() && sets_any {
             return Err((
                 "set".into(),
                 format!("constants are set on scene scripts; '{}' is a built-in scene (vary n, dt, seed or method)", self.scene),
