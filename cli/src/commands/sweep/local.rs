@@ -1,8 +1,8 @@
 //! Running a sweep's runs on this machine: a pool of `--jobs` workers, each starting one child
-//! `critterbox run` at a time; a progress bar of done, failed and left; signals forwarded once
-//! to the children, which finish their recordings and exit, and no result for a stopped run.
+//! `critterbox run` at a time; a progress bar of done, failed and left; no result for a run a
+//! signal stopped (`signals`).
 
-use super::{finished, plan, result_path, write_table, Planned, SweepArgs};
+use super::{finished, plan, result_path, signals, write_table, Planned, SweepArgs};
 use crate::commands::record;
 use anyhow::Context;
 use critterbox::sweep::{RunResult, RunSummary, SweepFile};
@@ -12,8 +12,7 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{mpsc, Mutex};
-use std::time::Duration;
+use std::sync::mpsc;
 
 /// A sweep stopped by a signal: `main` exits with 128 + its number, as `run` does.
 #[derive(Debug)]
@@ -94,7 +93,7 @@ pub fn run(
         todo.len()
     )?;
     out.flush()?;
-    record::watch_signals();
+    signals::watch();
     let (ok, failed, stopped) = execute(file, dir, &todo, jobs)?;
     writeln!(
         out,
@@ -110,7 +109,7 @@ pub fn run(
             dir.display()
         )?;
     }
-    if let Some(signal) = record::interrupted() {
+    if let Some(signal) = signals::interrupted() {
         return Err(Interrupted {
             signal,
             done: done.len() + ok + failed,
@@ -139,66 +138,43 @@ fn execute(
 ) -> anyhow::Result<(usize, usize, usize)> {
     let exe = std::env::current_exe().context("finding the critterbox executable")?;
     let next = AtomicUsize::new(0);
-    // The children running; a signal is forwarded to them under this lock, and a worker starts
-    // a child under it only while no signal has come, so none is missed.
-    let children: Mutex<Vec<u32>> = Mutex::new(Vec::new());
     let (tx, rx) = mpsc::channel::<Ended>();
     let bar = progress_bar(todo.len());
-    let (mut ok, mut failed, mut stopped) = (0, 0, 0);
+    let (mut ok, mut failed) = (0, 0);
     std::thread::scope(|scope| {
         for _ in 0..jobs.min(todo.len()) {
             let tx = tx.clone();
-            let (next, children, exe) = (&next, &children, &exe);
+            let (next, exe) = (&next, &exe);
             scope.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(run) = todo.get(i) else { break };
-                let ended = run_one(exe, file, dir, run, children);
-                if tx.send(ended).is_err() {
+                let ended = run_one(exe, file, dir, run);
+                if matches!(ended, Ended::Stopped) || tx.send(ended).is_err() {
                     break;
                 }
             });
         }
         drop(tx);
-        let mut forwarded = false;
-        loop {
-            match rx.recv_timeout(Duration::from_millis(100)) {
-                Ok(Ended::Ok) => ok += 1,
-                Ok(Ended::Failed) => failed += 1,
-                Ok(Ended::Stopped) => stopped += 1,
-                Err(mpsc::RecvTimeoutError::Timeout) => {}
-                Err(mpsc::RecvTimeoutError::Disconnected) => break,
-            }
-            if let (Some(sig), false) = (record::interrupted(), forwarded) {
-                forwarded = true;
-                let pids = children.lock().unwrap_or_else(|e| e.into_inner());
-                for &pid in pids.iter() {
-                    // SAFETY: kill(2) only sends a signal; the pid is a child not yet waited for.
-                    unsafe {
-                        libc::kill(pid as libc::pid_t, sig);
-                    }
-                }
+        for ended in rx {
+            match ended {
+                Ended::Ok => ok += 1,
+                Ended::Failed => failed += 1,
+                Ended::Stopped => {}
             }
             bar.set_position((ok + failed) as u64);
             bar.set_message(format!(
                 "{ok} ok, {failed} failed, {} left",
-                todo.len() - ok - failed - stopped
+                todo.len() - ok - failed
             ));
         }
     });
     bar.finish_and_clear();
-    // Runs never started count as not run, as do those the signal stopped.
-    let _ = stopped;
+    // Runs a signal stopped, or never started, are not run.
     Ok((ok, failed, todo.len() - ok - failed))
 }
 
 /// Runs one child to its end and writes its result (none when the sweep's signal stopped it).
-fn run_one(
-    exe: &Path,
-    file: &SweepFile,
-    dir: &Path,
-    run: &Planned,
-    children: &Mutex<Vec<u32>>,
-) -> Ended {
+fn run_one(exe: &Path, file: &SweepFile, dir: &Path, run: &Planned) -> Ended {
     let summary_path = dir.join("tmp").join(format!("{}.summary.json", run.hash));
     let _ = std::fs::remove_file(&summary_path);
     let mut cmd = Command::new(exe);
@@ -215,35 +191,23 @@ fn run_one(
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        // Its own process group: a terminal's Ctrl-C reaches the sweep alone, which forwards it
-        // once (a second signal would make a run quit without finishing its recording).
+        // Its own process group: signals reach it through the sweep alone (`signals`).
         .process_group(0);
-    let child = {
-        let mut pids = children.lock().unwrap_or_else(|e| e.into_inner());
-        if record::interrupted().is_some() {
-            return Ended::Stopped;
-        }
-        match cmd.spawn() {
-            Ok(child) => {
-                pids.push(child.id());
-                child
-            }
-            Err(e) => {
-                return write(
-                    dir,
-                    run,
-                    None,
-                    Some(format!("starting {}: {e}", exe.display())),
-                )
-            }
+    let child = match signals::spawn(&mut cmd) {
+        None => return Ended::Stopped,
+        Some(Ok(child)) => child,
+        Some(Err(e)) => {
+            return write(
+                dir,
+                run,
+                None,
+                Some(format!("starting {}: {e}", exe.display())),
+            )
         }
     };
     let pid = child.id();
     let output = child.wait_with_output();
-    children
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .retain(|&p| p != pid);
+    signals::forget(pid);
     let output = match output {
         Ok(o) => o,
         Err(e) => return write(dir, run, None, Some(format!("waiting for the run: {e}"))),
@@ -258,7 +222,7 @@ fn run_one(
             Err(e) => write(dir, run, None, Some(format!("the run's summary: {e}"))),
         };
     }
-    if record::interrupted().is_some() {
+    if signals::interrupted().is_some() {
         return Ended::Stopped;
     }
     write(dir, run, None, Some(error_text(&output)))

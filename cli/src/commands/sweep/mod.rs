@@ -9,6 +9,7 @@ mod collect;
 mod emit;
 mod local;
 mod plot;
+mod signals;
 
 pub use local::Interrupted;
 
@@ -49,7 +50,7 @@ pub struct SweepArgs {
     pub collect: Vec<PathBuf>,
     /// Write a scheduler's job instead of running: a Slurm job array or a Kubernetes Indexed Job,
     /// one task per shard.
-    #[arg(long, value_name = "SCHEDULER")]
+    #[arg(long, value_name = "SCHEDULER", conflicts_with = "shard")]
     pub emit: Option<Emit>,
     /// Shards of the emitted job (default: one per run, at most 16).
     #[arg(long, value_name = "N", requires = "emit", value_parser = clap::value_parser!(u64).range(1..))]
