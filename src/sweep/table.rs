@@ -106,14 +106,9 @@ impl Table {
         Table { columns, rows }
     }
 
-    /// The column's index, or an error listing the columns there are.
-    pub fn column(&self, name: &str) -> Result<usize, String> {
-        self.columns.iter().position(|c| c == name).ok_or_else(|| {
-            format!(
-                "the table has no column '{name}'; its columns are {}",
-                self.columns.join(", ")
-            )
-        })
+    /// The column's index.
+    pub fn column(&self, name: &str) -> Option<usize> {
+        self.columns.iter().position(|c| c == name)
     }
 
     /// The table as CSV (RFC 4180: a header line, cells quoted when they hold `,`, `"` or a

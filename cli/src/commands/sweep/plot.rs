@@ -24,9 +24,12 @@ pub fn draw(
         "--plot {spec}: write X:Y or X:Y:GROUP with the table's column names, e.g. --plot dt:energy_change:method"
     );
     let col = |name: &str| {
-        table
-            .column(name)
-            .map_err(|e| anyhow::anyhow!("--plot {spec}: {e}"))
+        table.column(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--plot {spec}: the table has no column '{name}'; its columns are {}",
+                table.columns.join(", ")
+            )
+        })
     };
     let (x, y) = (col(parts[0])?, col(parts[1])?);
     let group = parts.get(2).map(|g| col(g)).transpose()?;
