@@ -71,7 +71,7 @@ impl Table {
                     r.hash.clone(),
                     p.scene.clone(),
                     opt(p.method.clone()),
-                    opt(p.dt.map(|v| v.to_string())),
+                    opt(p.dt.map(num)),
                     opt(p.n.map(|v| v.to_string())),
                     opt(p.steps.map(|v| v.to_string())),
                     opt(p.seed.map(|v| v.to_string())),
@@ -126,6 +126,11 @@ impl Table {
     }
 }
 
+/// A number in its shortest exact form, with an exponent when very large or small.
+fn num(v: f64) -> String {
+    ryu::Buffer::new().format(v).to_string()
+}
+
 fn csv_cell(c: &str) -> String {
     if c.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", c.replace('"', "\"\""))
@@ -148,15 +153,15 @@ fn figure(s: &super::RunSummary, column: &str) -> String {
     }
     match column {
         "steps_done" => s.steps.to_string(),
-        "time" => s.time.to_string(),
+        "time" => num(s.time),
         "collisions" => s.collisions.to_string(),
         "impacts" => s.impacts.to_string(),
-        "energy_start" => s.energy_start.to_string(),
-        "energy_end" => s.energy_end.to_string(),
-        "energy_change" => s.energy_change.to_string(),
-        "momentum_change" => s.momentum_change.to_string(),
+        "energy_start" => num(s.energy_start),
+        "energy_end" => num(s.energy_end),
+        "energy_change" => num(s.energy_change),
+        "momentum_change" => num(s.momentum_change),
         "state_hash" => s.state_hash.clone(),
-        "wall_s" => s.wall_s.to_string(),
+        "wall_s" => num(s.wall_s),
         "reason" => s.reason.clone(),
         _ => String::new(),
     }
