@@ -52,6 +52,7 @@ pub mod profile;
 pub mod recording;
 pub mod scenes;
 pub mod script;
+pub mod sweep;
 pub mod testing;
 #[cfg(feature = "rerun")]
 pub mod viewer;

@@ -25,6 +25,8 @@ fn main() -> ExitCode {
             if let Some(i) = e.downcast_ref::<commands::record::Interrupted>() {
                 // 128 + the signal, as a shell reports a process the signal ended.
                 ExitCode::from(i.exit_code())
+            } else if let Some(i) = e.downcast_ref::<commands::sweep::Interrupted>() {
+                ExitCode::from(i.exit_code())
             } else if is_damaged_data(&e) {
                 ExitCode::from(DAMAGED_DATA)
             } else {

@@ -1,4 +1,5 @@
-//! `inspect --plot`: kinetic energy, momentum and collisions over the steps, as SVG or PNG.
+//! `inspect --plot`: kinetic energy, momentum and collisions over the steps, as SVG or PNG; the
+//! font and axis helpers the sweep's charts share.
 
 use critterbox::recording::Recording;
 use plotters::coord::Shift;
@@ -7,7 +8,7 @@ use std::path::Path;
 
 /// The labels' font: DejaVu Sans cut down to ASCII (see assets/fonts/LICENSE.txt), so PNG
 /// charts need no system fonts.
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-ascii.ttf");
+pub(crate) const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-ascii.ttf");
 
 /// Draws the chart to `path`: SVG for `.svg`, PNG for `.png`.
 pub fn totals_chart(rec: &Recording, path: &Path) -> anyhow::Result<()> {
@@ -27,7 +28,7 @@ pub fn totals_chart(rec: &Recording, path: &Path) -> anyhow::Result<()> {
     }
 }
 
-fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+pub(crate) fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
@@ -42,7 +43,7 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
+pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("drawing the chart: {e}")
 }
 

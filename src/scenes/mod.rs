@@ -147,6 +147,10 @@ impl AnyWorld {
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         both!(self, w => w.set_dt(dt))
     }
+    /// The scripts' shared state (`world().vars`).
+    pub fn vars(&self) -> &crate::critter::Props {
+        both!(self, w => w.vars())
+    }
     /// Log lines of the last step.
     pub fn log(&self) -> &[String] {
         both!(self, w => &w.events().log)

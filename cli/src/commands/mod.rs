@@ -12,6 +12,7 @@ pub mod recover;
 pub mod replay;
 pub mod run;
 pub mod stability;
+pub mod sweep;
 pub mod test;
 pub mod view;
 
@@ -49,6 +50,8 @@ pub enum Command {
     Chart(chart::ChartArgs),
     /// Run the stress scenes under every collision method and print the error table.
     Stability(stability::StabilityArgs),
+    /// Many runs from one TOML file: on all cores, one shard of them, or a scheduler's job.
+    Sweep(sweep::SweepArgs),
 }
 
 /// Runs the parsed command line. Output goes to `out`; progress to stderr.
@@ -64,6 +67,7 @@ pub fn execute(cli: Cli, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         Some(Command::Recover(args)) => recover::run(&args, out),
         Some(Command::Chart(args)) => chart::run(&args, out),
         Some(Command::Stability(args)) => stability::run(&args, out),
+        Some(Command::Sweep(args)) => sweep::run(&args, out),
         None => run::run(&run::RunArgs::default(), out),
     }
 }

@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// Also print time per stage and pair counts per step.
     #[arg(long)]
     pub stats: bool,
+    /// Also write the summary as JSON to FILE (written whole through a rename; not written
+    /// when the run fails): figures, final state hash, wall time, outcome, `world().vars`.
+    #[arg(long, value_name = "FILE")]
+    pub summary_json: Option<std::path::PathBuf>,
     /// Watching the run.
     #[command(flatten)]
     pub view: super::view::ViewArgs,
@@ -257,6 +261,20 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     };
     let recorded = recorder.is_some();
     record::finish(recorder, &scene, outcome, &reason, out)?;
+    if let Some(path) = &args.summary_json {
+        let summary = critterbox::sweep::RunSummary::of(
+            &scene.world,
+            &name,
+            energy0,
+            momentum0,
+            wall,
+            outcome,
+            &reason,
+        );
+        let json = serde_json::to_string_pretty(&summary)?;
+        critterbox::sweep::write_atomic(path, json.as_bytes())
+            .with_context(|| format!("--summary-json {}", path.display()))?;
+    }
     if let Some(signal) = interrupted {
         return Err(record::Interrupted {
             signal,

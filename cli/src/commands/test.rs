@@ -3,6 +3,7 @@
 use anyhow::Context;
 use clap::Args;
 use critterbox::script::{Limits, ScriptOptions};
+use critterbox::sweep::Shard;
 use critterbox::testing::{
     discover, find_test_files, junit_xml, run_tests, TestOptions, TestOutcome,
 };
@@ -33,6 +34,10 @@ pub struct TestArgs {
     /// Where failing tests' runs are recorded (default: recordings/test-failures; "none" to skip).
     #[arg(long, value_name = "DIR")]
     pub record_failures: Option<PathBuf>,
+    /// Run only the I-th of N slices of the tests (I from 1; test k of the list, in file and
+    /// name order, belongs to shard (k mod N) + 1), as `cargo nextest --partition count:I/N`.
+    #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
     /// Most operations one script call may run (endless-loop guard).
     #[arg(long, default_value_t = Limits::default().max_operations)]
     pub max_ops: u64,
@@ -59,6 +64,15 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             show_paths(&files)
         );
     }
+    let cases = match args.shard {
+        Some(shard) => {
+            let all = cases.len();
+            let mine = shard.select(cases);
+            writeln!(out, "shard {shard}: {} of {all} tests", mine.len())?;
+            mine
+        }
+        None => cases,
+    };
     let options = TestOptions {
         script: ScriptOptions {
             limits: Limits {
@@ -103,6 +117,14 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         if failed == 1 { "" } else { "s" }
     );
     Ok(())
+}
+
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    s.parse().map_err(|e: critterbox::sweep::SweepError| {
+        e.to_string()
+            .trim_start_matches(&format!("--shard {s}: "))
+            .to_string()
+    })
 }
 
 fn show_paths(paths: &[PathBuf]) -> String {
