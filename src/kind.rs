@@ -308,6 +308,46 @@ impl<V: Vector> KindSet<V> {
         Ok(self.insert(name, parent, defaults, hooks))
     }
 
+    /// Replaces kind `id`'s parent, defaults and hooks (its file was edited while the run goes
+    /// on). Errors, changing nothing, if the parent is unknown or would make a cycle, or the
+    /// defaults are out of range.
+    pub fn replace(
+        &mut self,
+        id: KindId,
+        parent: Option<&str>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Result<(), Error> {
+        let name = self.get(id).name.clone();
+        let parent = match parent {
+            Some(p) => Some(self.id(p)?),
+            None => None,
+        };
+        if parent.is_some_and(|p| self.is_kind(p, id)) {
+            return Err(Error::InvalidKind {
+                kind: name,
+                reason: "its new parent extends it; a kind cannot extend itself".into(),
+            });
+        }
+        check_defaults(&name, &defaults)?;
+        let kind = &mut self.kinds[id.0 as usize];
+        *kind = Kind {
+            name,
+            parent,
+            has_update: hooks.has_update(),
+            has_init: hooks.has_init(),
+            has_collide: hooks.has_collide(),
+            has_touch_hooks: hooks.has_touch_hooks(),
+            has_on_death: hooks.has_on_death(),
+            rule_depends_on_state: hooks.rule_depends_on_state(),
+            defaults,
+            hooks,
+        };
+        self.tracks_touch = self.kinds.iter().any(|k| k.hooks.tracks_touch());
+        self.has_on_death = self.kinds.iter().any(|k| k.has_on_death);
+        Ok(())
+    }
+
     /// The kind called `name`.
     pub fn id(&self, name: &str) -> Result<KindId, Error> {
         self.by_name

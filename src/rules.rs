@@ -224,6 +224,15 @@ impl RuleCache {
         (code != UNKNOWN).then(|| Some(decode(code)))
     }
 
+    /// Forgets every pair's roles and asks `kinds` again whether each class's rule depends on
+    /// state (a kind's hooks were replaced). The classes stay as they are.
+    pub(crate) fn forget_roles<V: Vector>(&mut self, kinds: &KindSet<V>) {
+        self.table.fill(UNKNOWN);
+        for (&(kind, _, _), &class) in &self.index {
+            self.uncached[class as usize] = kinds.get(kind).rule_depends_on_state;
+        }
+    }
+
     /// Number of class pairs whose roles were computed from the hooks so far.
     pub fn computed(&self) -> u64 {
         self.lookups_computed

@@ -59,6 +59,8 @@ pub struct RerunSink {
     /// Told when the logging thread has drawn everything.
     done: Option<Receiver<()>>,
     thread: Option<JoinHandle<()>>,
+    /// Lines to show with the next step drawn (a kind reloaded, `run --watch`).
+    notes: Vec<String>,
 }
 
 /// A colour for a kind: its `color` default if it names one we know, else one from a palette.
@@ -127,7 +129,13 @@ impl RerunSink {
             spare: None,
             done: None,
             thread: None,
+            notes: Vec::new(),
         })
+    }
+
+    /// Shows `line` in the log with the next step drawn (a kind reloaded between steps).
+    pub fn note(&mut self, line: String) {
+        self.notes.push(line);
     }
 
     /// Turns velocity arrows on or off (before the first step is logged).
@@ -280,6 +288,7 @@ impl RerunSink {
             AnyWorld::D2(w) => frame.fill(w, step_time),
             AnyWorld::D3(w) => frame.fill(w, step_time),
         }
+        frame.notes = std::mem::take(&mut self.notes);
         self.send(frame);
         self.logging += started.elapsed();
     }
@@ -383,6 +392,8 @@ struct Frame {
     spawns: Vec<CritterId>,
     deaths: Vec<CritterId>,
     log: Vec<String>,
+    /// Lines from the run around the world (a kind reloaded before this step).
+    notes: Vec<String>,
     kinetic_energy: f64,
     momentum: [f64; 3],
     collisions: u64,
@@ -407,6 +418,7 @@ impl Frame {
             spawns: Vec::new(),
             deaths: Vec::new(),
             log: Vec::new(),
+            notes: Vec::new(),
             kinetic_energy: 0.0,
             momentum: [0.0; 3],
             collisions: 0,
@@ -647,6 +659,9 @@ impl Drawer {
                 "log",
                 &rerun::TextLog::new(line.clone()).with_level("DEBUG"),
             );
+        }
+        for line in &f.notes {
+            let _ = rec.log("log", &rerun::TextLog::new(line.clone()).with_level("INFO"));
         }
 
         // Totals.

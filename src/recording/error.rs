@@ -166,6 +166,16 @@ pub enum RecordingError {
         /// The step's error.
         error: crate::Error,
     },
+    /// A recorded reload could not be made again.
+    #[error("the reload of {file} after step {step} could not be made again: {reason}")]
+    Reload {
+        /// Steps taken when the kind file was reloaded.
+        step: u64,
+        /// The kind file.
+        file: String,
+        /// Why not.
+        reason: String,
+    },
     /// The scene asked to stop before the step a replay was to reach.
     #[error("the scene stopped after step {step} ({reason})")]
     SceneStopped {

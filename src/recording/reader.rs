@@ -242,6 +242,10 @@ pub struct Recording {
     pub end: Option<EndMeta>,
     /// Script files: (name = path loaded from, text).
     pub scripts: Vec<(String, String)>,
+    /// Kind files reloaded while the run went on, in order (`run --watch`).
+    pub reloads: Vec<schema::ReloadMsg>,
+    /// The reloaded texts, by attachment name.
+    pub reload_texts: BTreeMap<String, String>,
     /// Hash after each step, by step.
     pub hashes: BTreeMap<u64, u64>,
     /// Totals after each step.
@@ -451,6 +455,15 @@ impl Recording {
                     let text = String::from_utf8_lossy(data).into_owned();
                     rec.scripts.push((name.to_string(), text));
                 }
+                Item::Attachment {
+                    name,
+                    media_type,
+                    data,
+                    ..
+                } if media_type == schema::RELOAD_MEDIA_TYPE => {
+                    let text = String::from_utf8_lossy(data).into_owned();
+                    rec.reload_texts.insert(name.to_string(), text);
+                }
                 Item::Damaged(damage) => rec.gaps.push(Gap {
                     damage: damage.clone(),
                     after: rec.hashes.keys().next_back().copied(),
@@ -536,6 +549,7 @@ impl Recording {
                 self.collisions.insert(c.step, c.caller.len());
             }
             schema::LIFECYCLE => self.lifecycle.push(decode(topic, data)?),
+            schema::RELOAD => self.reloads.push(decode(topic, data)?),
             schema::LOG => self.log.push(decode(topic, data)?),
             schema::ERROR => self.error = Some(decode(topic, data)?),
             _ => {}

@@ -19,7 +19,33 @@ use std::path::{Path, PathBuf};
 pub struct Rebuilt {
     /// The scene, at step 0.
     pub scene: Scene,
+    /// Each attached kind file's recorded path and where its copy is.
+    kinds: Vec<(String, PathBuf)>,
     _dir: Option<TempDir>,
+}
+
+impl Rebuilt {
+    /// Where the rebuilt scene loaded the recorded kind file `file` from.
+    pub fn kind_path(&self, file: &str) -> Option<String> {
+        let at = self.kinds.iter().find(|(name, _)| name == file)?;
+        Some(at.1.display().to_string())
+    }
+
+    /// `text` with every recorded kind path in quotes pointed at its copy.
+    pub fn repoint(&self, text: &str) -> String {
+        repoint(&self.kinds, text)
+    }
+}
+
+fn repoint(kinds: &[(String, PathBuf)], text: &str) -> String {
+    let mut text = text.to_string();
+    for (name, at) in kinds {
+        let quoted = format!("\"{name}\"");
+        if text.contains(&quoted) {
+            text = text.replace(&quoted, &format!("{:?}", at.display().to_string()));
+        }
+    }
+    text
 }
 
 /// A temporary folder, removed on drop.
@@ -63,7 +89,7 @@ fn file_name(path: &str) -> String {
 /// Rebuilds the recorded scene at step 0, with the recorded dt override applied.
 pub fn rebuild(rec: &Recording) -> Result<Rebuilt, RecordingError> {
     let meta = rec.meta();
-    let (mut scene, dir) = match &meta.source {
+    let (mut scene, kinds, dir) = match &meta.source {
         SceneSource::Builtin => {
             let params = SceneParams {
                 n: meta.n,
@@ -76,15 +102,15 @@ pub fn rebuild(rec: &Recording) -> Result<Rebuilt, RecordingError> {
                     version: meta.version.clone(),
                     error: Box::new(error),
                 })?;
-            (scene, None)
+            (scene, Vec::new(), None)
         }
         SceneSource::Test { case } => {
             return Err(RecordingError::BuiltByTest { case: case.clone() })
         }
         SceneSource::Script { file } => {
             let dir = TempDir::new("critterbox-replay").map_err(RecordingError::TempFolder)?;
-            let scene = load_script_scene(rec, file, dir.path())?;
-            (scene, Some(dir))
+            let (scene, kinds) = load_script_scene(rec, file, dir.path())?;
+            (scene, kinds, Some(dir))
         }
     };
     let method = meta
@@ -98,14 +124,18 @@ pub fn rebuild(rec: &Recording) -> Result<Rebuilt, RecordingError> {
     if let Some(dt) = meta.dt_override {
         scene.world.set_dt(dt)?;
     }
-    Ok(Rebuilt { scene, _dir: dir })
+    Ok(Rebuilt {
+        scene,
+        kinds,
+        _dir: dir,
+    })
 }
 
 fn load_script_scene(
     rec: &Recording,
     scene_file: &str,
     dir: &Path,
-) -> Result<Scene, RecordingError> {
+) -> Result<(Scene, Vec<(String, PathBuf)>), RecordingError> {
     let meta = rec.meta();
     let scene_text = rec
         .scripts
@@ -120,22 +150,13 @@ fn load_script_scene(
     std::fs::create_dir_all(&kinds_dir)?;
     std::fs::create_dir_all(&scenes_dir)?;
     // Kinds: each at kinds/<file name>; a kind named by path in a script is pointed there.
-    let kinds: Vec<(&str, PathBuf)> = rec
+    let kinds: Vec<(String, PathBuf)> = rec
         .scripts
         .iter()
         .filter(|(name, _)| name != scene_file)
-        .map(|(name, _)| (name.as_str(), kinds_dir.join(file_name(name))))
+        .map(|(name, _)| (name.clone(), kinds_dir.join(file_name(name))))
         .collect();
-    let repoint = |text: &str| {
-        let mut text = text.to_string();
-        for (name, at) in &kinds {
-            let quoted = format!("\"{name}\"");
-            if text.contains(&quoted) {
-                text = text.replace(&quoted, &format!("{:?}", at.display().to_string()));
-            }
-        }
-        text
-    };
+    let repoint = |text: &str| repoint(&kinds, text);
     for (name, text) in &rec.scripts {
         if name == scene_file {
             continue;
@@ -151,8 +172,11 @@ fn load_script_scene(
         ..ScriptOptions::default()
     };
     // The attached scene text already has the --set values in it.
-    script::load_scene(&scene_path, &[], &options).map_err(|error| RecordingError::ScriptScene {
-        scene: meta.scene.clone(),
-        error: Box::new(error),
-    })
+    let scene = script::load_scene(&scene_path, &[], &options).map_err(|error| {
+        RecordingError::ScriptScene {
+            scene: meta.scene.clone(),
+            error: Box::new(error),
+        }
+    })?;
+    Ok((scene, kinds))
 }

@@ -24,15 +24,57 @@ use std::sync::Arc;
 pub struct Replay {
     rebuilt: Rebuilt,
     stopped: Option<String>,
+    /// The recorded reloads (step, kind file, new text), in order, and how many are made.
+    reloads: Vec<(u64, String, String)>,
+    reloaded: usize,
 }
 
 impl Replay {
     /// The recorded scene at step 0.
     pub fn new(rec: &Recording) -> Result<Replay, RecordingError> {
+        let mut reloads = Vec::with_capacity(rec.reloads.len());
+        for r in &rec.reloads {
+            let Some(text) = rec.reload_texts.get(&r.attachment) else {
+                return Err(RecordingError::Reload {
+                    step: r.step,
+                    file: r.file.clone(),
+                    reason: format!("the file has no attachment '{}'", r.attachment),
+                });
+            };
+            reloads.push((r.step, r.file.clone(), text.clone()));
+        }
         Ok(Replay {
             rebuilt: rebuild(rec)?,
             stopped: None,
+            reloads,
+            reloaded: 0,
         })
+    }
+
+    /// Makes the recorded reloads of kind files that came after at most `step` steps, as the
+    /// run made them (between two steps).
+    fn reload_through(&mut self, step: u64) -> Result<(), RecordingError> {
+        while let Some((at, file, text)) = self.reloads.get(self.reloaded) {
+            if *at > step {
+                break;
+            }
+            let fail = |reason: String| RecordingError::Reload {
+                step: *at,
+                file: file.clone(),
+                reason,
+            };
+            let path = self
+                .rebuilt
+                .kind_path(file)
+                .ok_or_else(|| fail("the file holds no copy of that kind file".into()))?;
+            let text = self.rebuilt.repoint(text);
+            self.rebuilt
+                .scene
+                .reload_kind(&path, &text)
+                .map_err(|e| fail(e.to_string()))?;
+            self.reloaded += 1;
+        }
+        Ok(())
     }
 
     /// The world now.
@@ -61,6 +103,7 @@ impl Replay {
                 .into());
             }
             let at = self.step_count();
+            self.reload_through(at)?;
             match self.rebuilt.scene.step() {
                 Ok(stop) => self.stopped = stop,
                 Err(error) => return Err(RecordingError::StepFailed { step: at, error }.into()),
@@ -70,15 +113,30 @@ impl Replay {
         Ok(())
     }
 
-    /// Puts the world in a recorded full state (see [`restore_any`]).
+    /// Puts the world in a recorded full state (see [`restore_any`]), with the kinds as they
+    /// were then: the reloads before that step are made first.
     pub fn restore(&mut self, state: &StateMsg) -> Result<(), String> {
         self.stopped = None;
+        if self.reloads[..self.reloaded]
+            .iter()
+            .any(|(at, _, _)| *at >= state.step)
+        {
+            return Err(format!(
+                "kinds were reloaded at or after step {}, so its state cannot be put back",
+                state.step
+            ));
+        }
+        self.reload_through(state.step.saturating_sub(1))
+            .map_err(|e| e.to_string())?;
         restore_any(&mut self.rebuilt.scene.world, state)
     }
 
     /// Takes one more step, expecting it to fail (the recording ended with an error); returns the
     /// error, or `None` if the step succeeded.
     pub fn step_expecting_error(&mut self) -> Option<String> {
+        if let Err(e) = self.reload_through(self.step_count()) {
+            return Some(e.to_string());
+        }
         match self.rebuilt.scene.step() {
             Ok(stop) => {
                 self.stopped = stop;

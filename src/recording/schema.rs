@@ -30,6 +30,8 @@ pub const LOG: &str = "/critterbox/log";
 pub const ERROR: &str = "/critterbox/error";
 /// The critters as Foxglove spheres and walls as cubes, on the steps with a full state.
 pub const SCENE: &str = "/foxglove/scene";
+/// Topic: a kind replaced from its edited file between two steps (`run --watch`).
+pub const RELOAD: &str = "/critterbox/reload";
 
 /// Name of the metadata record written first: how the run was made.
 pub const META: &str = "critterbox";
@@ -46,6 +48,8 @@ pub const FORMAT: &str = "critterbox-recording/1";
 pub const STATE_HASH: &str = "3";
 /// Media type of the script attachments.
 pub const SCRIPT_MEDIA_TYPE: &str = "text/x-rhai";
+/// Media type of the new text of a reloaded kind file (named as its [`ReloadMsg`] says).
+pub const RELOAD_MEDIA_TYPE: &str = "text/x-rhai-reload";
 
 /// A critter id as recorded: `generation * 2^32 + index`.
 pub fn id_key(id: CritterId) -> u64 {
@@ -454,6 +458,22 @@ pub struct LogMsg {
     pub lines: Vec<String>,
 }
 
+/// `/critterbox/reload`: a kind file's new text replaced its kinds after step `step` (before
+/// the next one).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReloadMsg {
+    /// Steps taken when the kinds were replaced.
+    pub step: u64,
+    /// Simulated time then.
+    pub time: Float,
+    /// The kind file, as the run loaded it.
+    pub file: String,
+    /// The attachment holding the new text.
+    pub attachment: String,
+    /// The kinds replaced: the file's kind, then the kinds that extend it.
+    pub kinds: Vec<String>,
+}
+
 /// `/critterbox/error`: the error that stopped the run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ErrorMsg {
@@ -654,6 +674,16 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
         step_props(json!({ "lines": { "type": "array", "items": { "type": "string" } } })),
         &["step", "time", "lines"],
     );
+    let reload = object(
+        "critterbox.Reload",
+        "A kind file edited while the run went on: its new text replaced its kinds after step `step`",
+        step_props(json!({
+            "file": { "type": "string", "description": "the kind file, as the run loaded it" },
+            "attachment": { "type": "string", "description": "the attachment (media type text/x-rhai-reload) holding the new text" },
+            "kinds": { "type": "array", "items": { "type": "string" }, "description": "the kinds replaced: the file's kind, then those that extend it" },
+        })),
+        &["step", "time", "file", "attachment", "kinds"],
+    );
     let error = object(
         "critterbox.Error",
         "The error that stopped the run in step `step` (the steps before it were recorded)",
@@ -695,6 +725,11 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
             topic: ERROR,
             name: "critterbox.Error",
             schema: error,
+        },
+        ChannelSchema {
+            topic: RELOAD,
+            name: "critterbox.Reload",
+            schema: reload,
         },
         ChannelSchema {
             topic: SCENE,

@@ -11,7 +11,7 @@ use super::capture::{self, KindTable, StepRecord};
 use super::error::RecordingError;
 use super::foxglove;
 use super::meta::{EndMeta, RunMeta, SETUP_FAILED};
-use super::schema::{self, ErrorMsg, Float, HashMsg, StateMsg};
+use super::schema::{self, ErrorMsg, Float, HashMsg, ReloadMsg, StateMsg};
 use crate::scenes::{AnyWorld, SourceFile};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::{Attachment, WriteOptions};
@@ -42,6 +42,7 @@ enum Job {
     State(Box<StateMsg>),
     Error(ErrorMsg),
     Attach(Vec<SourceFile>),
+    Reload(ReloadMsg, String),
     Finish(EndMeta),
 }
 
@@ -218,6 +219,27 @@ impl Recorder {
         }))
     }
 
+    /// Records that `text`, the new text of the kind file `file`, replaced the kinds `kinds`
+    /// after the last step recorded: the text as an attachment, and a reload message naming
+    /// it, so a replay makes the same swap at the same step.
+    pub fn reload(
+        &mut self,
+        world: &AnyWorld,
+        file: &str,
+        text: &str,
+        kinds: Vec<String>,
+    ) -> Result<(), RecordingError> {
+        let step = world.step_count();
+        let msg = ReloadMsg {
+            step,
+            time: Float(world.time()),
+            file: file.to_string(),
+            attachment: reload_attachment(file, step),
+            kinds,
+        };
+        self.send(Job::Reload(msg, text.to_string()))
+    }
+
     /// Attaches more script files (kinds loaded after the scene was set up).
     pub fn attach(&mut self, sources: Vec<SourceFile>) -> Result<(), RecordingError> {
         if sources.is_empty() {
@@ -389,6 +411,11 @@ fn attach<W: std::io::Write + std::io::Seek>(
     })
 }
 
+/// The name of the attachment holding the text `file` was reloaded with after step `step`.
+pub fn reload_attachment(file: &str, step: u64) -> String {
+    format!("{file}@{step}")
+}
+
 /// The writer thread's side.
 struct Output {
     w: McapFile,
@@ -537,6 +564,17 @@ impl Output {
                 for s in &sources {
                     attach(&mut self.w, s)?;
                 }
+            }
+            Job::Reload(msg, text) => {
+                let t = self.log_time(msg.time.0);
+                self.w.attach(&Attachment {
+                    log_time: t,
+                    create_time: t,
+                    name: msg.attachment.clone(),
+                    media_type: schema::RELOAD_MEDIA_TYPE.into(),
+                    data: Cow::Borrowed(text.as_bytes()),
+                })?;
+                self.put_json(schema::RELOAD, t, &msg)?;
             }
             Job::Finish(_) => {}
         }

@@ -186,7 +186,13 @@ pub struct Scene {
     pub(crate) loaded_since: Option<Box<dyn Fn(usize) -> Vec<SourceFile>>>,
     /// The script profiler of a script scene's hooks (`run --stats`), off until turned on.
     pub profiler: Option<std::rc::Rc<crate::profile::Profiler>>,
+    /// Replaces a kind from a new text of its file (set for script scenes; see
+    /// [`Scene::reload_kind`]).
+    pub(crate) reloader: Option<Reloader>,
 }
+
+/// How a script scene replaces a kind: the world, the kind's file as loaded, its new text.
+pub(crate) type Reloader = Box<dyn Fn(&mut AnyWorld, &str, &str) -> Result<Vec<String>, Error>>;
 
 impl Scene {
     /// A scene of `world` with no script around it.
@@ -199,6 +205,22 @@ impl Scene {
             sources: Vec::new(),
             loaded_since: None,
             profiler: None,
+            reloader: None,
+        }
+    }
+
+    /// Replaces the kind that the script file `file` (its path as loaded, as in
+    /// [`Scene::sources`]) defines with the one `text` defines, between two steps: hot reload.
+    /// Kinds that extend it are rebuilt on it. Critters keep their state; critters spawned
+    /// from now on get the new defaults. Returns the names of the kinds replaced. A text that
+    /// does not compile, or a file of no loaded kind, is an error and changes nothing.
+    pub fn reload_kind(&mut self, file: &str, text: &str) -> Result<Vec<String>, Error> {
+        match &self.reloader {
+            Some(reload) => reload(&mut self.world, file, text),
+            None => Err(Error::from(crate::error::ScriptError::new(
+                file,
+                "this scene loads no kind files: only a script scene's kinds can be reloaded",
+            ))),
         }
     }
 

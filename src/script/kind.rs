@@ -79,6 +79,9 @@ pub(crate) struct HookFn {
 pub(crate) struct ScriptKindDef {
     pub name: String,
     pub file: String,
+    /// The file's text it was built from (a kind extending this one is rebuilt from its own
+    /// text when this one is reloaded).
+    pub text: Rc<str>,
     pub parent: Option<String>,
     pub defaults: KindDefaults,
     pub rule_depends_on_state: bool,
@@ -161,8 +164,24 @@ pub(crate) fn define(
     name: String,
     text: String,
 ) -> Result<Rc<ScriptKindDef>, Error> {
+    let def = build(rt, file.clone(), name.clone(), &text)?;
+    rt.sources
+        .borrow_mut()
+        .push(SourceFile { path: file, text });
+    rt.kinds.borrow_mut().insert(name, def.clone());
+    Ok(def)
+}
+
+/// The kind `name` built from `text`, the text of its file `file`, its parents loaded; not yet
+/// among the runtime's kinds.
+pub(crate) fn build(
+    rt: &Runtime,
+    file: String,
+    name: String,
+    text: &str,
+) -> Result<Rc<ScriptKindDef>, Error> {
     let ast = rt
-        .compile(&file, &text)
+        .compile(&file, text)
         .map_err(|e| in_kind(e, &file, &name))?;
 
     // Run the top level once, with no world reachable: it declares, it does not act.
@@ -240,7 +259,7 @@ pub(crate) fn define(
                 ),
             };
             let mut e = ScriptError::new(&file, message);
-            if let Some((l, c)) = fn_location(&text, hook) {
+            if let Some((l, c)) = fn_location(text, hook) {
                 e.line = Some(l);
                 e.column = Some(c);
             }
@@ -260,7 +279,7 @@ pub(crate) fn define(
             hooks[i] = match found[i] {
                 Some(params) => Some(Rc::new(HookFn {
                     file: file.clone(),
-                    line: fn_location(&text, hook),
+                    line: fn_location(text, hook),
                     params,
                     owner: me.clone(),
                     scope: RefCell::new(Scope::new()),
@@ -272,6 +291,7 @@ pub(crate) fn define(
             ast,
             name: name.clone(),
             file: file.clone(),
+            text: Rc::from(text),
             parent: decl.parent.clone(),
             defaults,
             rule_depends_on_state,
@@ -279,10 +299,6 @@ pub(crate) fn define(
             parent_def: parent.clone(),
         }
     });
-    rt.sources
-        .borrow_mut()
-        .push(SourceFile { path: file, text });
-    rt.kinds.borrow_mut().insert(name, def.clone());
     Ok(def)
 }
 

@@ -17,6 +17,7 @@ pub(crate) mod kind;
 pub(crate) mod kind_calls;
 pub(crate) mod kind_refs;
 pub mod lint;
+pub(crate) mod reload;
 
 pub(crate) mod scene;
 

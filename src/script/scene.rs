@@ -193,6 +193,13 @@ fn set_up(rt: &Rc<Runtime>, path: &Path, file: &str, text: &str) -> Result<Scene
             .map(<[_]>::to_vec)
             .unwrap_or_default()
     }));
+    let reloading = rt.clone();
+    scene.reloader = Some(Box::new(
+        move |world: &mut AnyWorld, file: &str, text: &str| match world {
+            AnyWorld::D2(w) => super::reload::reload(&reloading, w, file, text),
+            AnyWorld::D3(w) => super::reload::reload(&reloading, w, file, text),
+        },
+    ));
     if let Some(on_step) = on_step {
         scene.on_step = Some(Box::new(move |world: &mut AnyWorld| on_step.call(world)));
     }

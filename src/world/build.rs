@@ -87,6 +87,24 @@ impl<V: Vector> World<V> {
         self.state.kinds.register(name, parent, defaults, hooks)
     }
 
+    /// Replaces kind `id`'s parent, defaults and hooks: its file was edited while the run goes
+    /// on. Its critters keep their state; critters spawned from now on get the new defaults.
+    /// What the world kept that the old hooks decided (the pairs' roles, the broad phase's
+    /// list, the method's kept state) is dropped, so the next step asks the new hooks.
+    pub fn replace_kind(
+        &mut self,
+        id: KindId,
+        parent: Option<&str>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Result<(), Error> {
+        self.state.kinds.replace(id, parent, defaults, hooks)?;
+        self.state.rules.forget_roles(&self.state.kinds);
+        self.pairs.broad.forget_list();
+        self.methods.forget();
+        Ok(())
+    }
+
     /// Adds a wall (always fixed, priority CP_WALL, kind `wall`).
     pub fn add_wall(&mut self, wall: WallBox<V>) -> Result<CritterId, Error> {
         self.state.add_wall(wall)

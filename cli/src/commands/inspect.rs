@@ -60,6 +60,24 @@ pub fn run(args: &InspectArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         "lifecycle    {spawns} spawns, {deaths} deaths, {damages} damage events"
     )?;
     writeln!(out, "log          {lines} lines")?;
+    if rec.reloads.is_empty() {
+        writeln!(out, "reloads      none")?;
+    }
+    for (i, r) in rec.reloads.iter().enumerate() {
+        writeln!(
+            out,
+            "{}after step {}: {} ({}), text in attachment '{}'",
+            if i == 0 {
+                "reloads      "
+            } else {
+                "             "
+            },
+            r.step,
+            r.file,
+            r.kinds.join(", "),
+            r.attachment
+        )?;
+    }
     let channels: Vec<String> = rec
         .messages
         .iter()

@@ -15,6 +15,7 @@ pub mod stability;
 pub mod sweep;
 pub mod test;
 pub mod view;
+pub mod watch;
 
 use clap::{Parser, Subcommand};
 

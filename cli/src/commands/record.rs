@@ -148,6 +148,19 @@ impl RunRecording {
         self.attach_new(scene)
     }
 
+    /// Records that `text`, the new text of the kind file `file`, replaced the kinds `kinds`
+    /// after the last step recorded.
+    pub fn reload(
+        &mut self,
+        scene: &Scene,
+        file: &str,
+        text: &str,
+        kinds: Vec<String>,
+    ) -> anyhow::Result<()> {
+        self.attach_new(scene)?;
+        Ok(self.rec.reload(&scene.world, file, text, kinds)?)
+    }
+
     fn attach_new(&mut self, scene: &Scene) -> anyhow::Result<()> {
         let new = scene.sources_since(self.attached);
         if !new.is_empty() {

@@ -10,7 +10,7 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 /// Arguments of `critterbox run`.
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 #[command(
     after_help = "Exit codes: 0 when the run completed or the scene stopped it; 1 on an \
 error (a scene that cannot be built is still recorded, with its scripts and the error); \
@@ -70,6 +70,13 @@ pub struct RunArgs {
     /// when the run fails): figures, final state hash, wall time, outcome, `world().vars`.
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<std::path::PathBuf>,
+    /// Watch the script files the run loaded: an edited kind file replaces its kind at the next
+    /// step (recorded, so the replay makes the same swap); an edited scene file runs the scene
+    /// again from step 0 (`--record run.mcap`: run.mcap, run-2.mcap, ...); a file that does not
+    /// compile leaves the old version running. After the run, any edit runs it again. Ctrl-C
+    /// stops (docs/scripting.md, "Edit while it runs").
+    #[arg(long)]
+    pub watch: bool,
     /// Watching the run.
     #[command(flatten)]
     pub view: super::view::ViewArgs,
@@ -78,8 +85,28 @@ pub struct RunArgs {
     pub recording: RecordArgs,
 }
 
+/// How a run ended, when it did not fail.
+pub enum Ended {
+    /// It ran its steps, the scene stopped it, or a signal did.
+    Finished,
+    /// Its scene file changed (`--watch`): run it again.
+    SceneChanged,
+}
+
 /// Runs the command.
 pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
+    if args.watch && !args.list {
+        return super::watch::run_watching(args, out);
+    }
+    run_once(args, out, None).map(|_| ())
+}
+
+/// Runs the scene once; with `watch`, watches its script files and applies their edits.
+pub fn run_once(
+    args: &RunArgs,
+    out: &mut dyn Write,
+    mut watch: Option<&mut super::watch::Watch>,
+) -> anyhow::Result<Ended> {
     if args.list {
         writeln!(out, "built-in scenes (critterbox run NAME):")?;
         for s in SCENES {
@@ -90,7 +117,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             };
             writeln!(out, "  {:<10} {}{}", s.name, s.about, mark)?;
         }
-        return Ok(());
+        return Ok(Ended::Finished);
     }
     if let Some(dt) = args.dt {
         anyhow::ensure!(
@@ -109,8 +136,18 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             name,
             file,
             sources,
-        }) => return failed_setup(args, &name, file.as_deref(), &sources, error, out),
+        }) => {
+            if let Some(w) = watch.as_deref_mut() {
+                w.add(&sources)?;
+            }
+            return failed_setup(args, &name, file.as_deref(), &sources, error, out)
+                .map(|()| Ended::Finished);
+        }
     };
+    if let Some(w) = watch.as_deref_mut() {
+        w.add(&scene.sources)?;
+    }
+    let scene_file = scene.sources.first().map(|s| s.path.clone());
     if let Err(error) = configure(&mut scene, args) {
         let file = scene.sources.first().map(|s| s.path.clone());
         return failed_setup(
@@ -120,7 +157,8 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             &scene.sources,
             error,
             out,
-        );
+        )
+        .map(|()| Ended::Finished);
     }
     let name = scene.name.clone();
     let steps = args.steps.unwrap_or(scene.default_steps);
@@ -134,6 +172,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let bar = progress_bar(steps);
     let started = Instant::now();
     let mut stopped = None;
+    let mut scene_changed = false;
     // Time the simulation thread spends recording (hash, totals, events, handing them over).
     let mut recording = Duration::ZERO;
     for i in 0..steps {
@@ -182,6 +221,27 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         if let Some(reason) = outcome {
             stopped = Some((scene.world.step_count(), reason));
             break;
+        }
+        if let Some(w) = watch.as_deref_mut() {
+            // Kinds the step loaded are watched too.
+            let new = scene.sources_since(w.added());
+            if !new.is_empty() {
+                w.add(&new)?;
+            }
+            let changed = w.changed();
+            let file = scene_file.as_deref();
+            let edits = match changed.is_empty() {
+                true => Edits::Applied,
+                false => {
+                    bar.suspend(|| apply(changed, &mut scene, &mut recorder, &mut viewer, file))?
+                }
+            };
+            if edits == Edits::SceneChanged {
+                let reason = "its scene file changed (--watch)".to_string();
+                stopped = Some((scene.world.step_count(), reason));
+                scene_changed = true;
+                break;
+            }
         }
         if i % 16 == 15 {
             bar.set_position(i + 1);
@@ -283,7 +343,55 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         }
         .into());
     }
-    Ok(())
+    Ok(if scene_changed {
+        Ended::SceneChanged
+    } else {
+        Ended::Finished
+    })
+}
+
+/// What the watched files' edits did between two steps.
+#[derive(PartialEq)]
+enum Edits {
+    /// Nothing, or kinds reloaded (or edits that did not compile, reported).
+    Applied,
+    /// The scene file changed: the run starts again.
+    SceneChanged,
+}
+
+/// Applies edits of the watched files (path as loaded, new text) between two steps: a kind
+/// file's new text replaces its kinds (and is recorded); a text that does not compile is
+/// reported and the old one runs on; a change of the scene file ends the run.
+fn apply(
+    changed: Vec<(String, String)>,
+    scene: &mut Scene,
+    recorder: &mut Option<record::RunRecording>,
+    viewer: &mut super::view::Viewer,
+    scene_file: Option<&str>,
+) -> anyhow::Result<Edits> {
+    let step = scene.world.step_count();
+    for (file, text) in changed {
+        if Some(file.as_str()) == scene_file {
+            return Ok(Edits::SceneChanged);
+        }
+        match scene.reload_kind(&file, &text) {
+            Ok(kinds) => {
+                let line = format!(
+                    "watch: after step {step}: {file} reloaded (kind {})",
+                    kinds.join(", ")
+                );
+                eprintln!("{line}");
+                viewer.note(line);
+                if let Some(r) = recorder {
+                    r.reload(scene, &file, &text, kinds)?;
+                }
+            }
+            Err(e) => eprintln!(
+                "watch: after step {step}: {file} not reloaded, the old version runs on: {e}"
+            ),
+        }
+    }
+    Ok(Edits::Applied)
 }
 
 /// Why no scene came out of [`load`].

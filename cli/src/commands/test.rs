@@ -41,6 +41,11 @@ pub struct TestArgs {
     /// Most operations one script call may run (endless-loop guard).
     #[arg(long, default_value_t = Limits::default().max_operations)]
     pub max_ops: u64,
+    /// After the run, watch the test files and the kind and scene files beside them: an edit
+    /// re-runs the tests it affects (a test file's own tests; for a kind or scene file, the
+    /// tests of the files that name it, or all when none does). Ctrl-C stops.
+    #[arg(long)]
+    pub watch: bool,
 }
 
 /// Runs the tests; any failure is an error (non-zero exit) after every test has run.
@@ -91,6 +96,26 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         },
         bless: args.bless,
     };
+    let failed = run_cases(&cases, &options, args.junit.as_deref(), out)?;
+    if args.watch {
+        return watch_tests(args, &files, &options, out);
+    }
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} script test{} failed",
+        if failed == 1 { "" } else { "s" }
+    );
+    Ok(())
+}
+
+/// Runs `cases`, printing a line per test and the totals (and JUnit XML to `junit`); returns
+/// how many failed.
+fn run_cases(
+    cases: &[critterbox::testing::TestCase],
+    options: &TestOptions,
+    junit: Option<&std::path::Path>,
+    out: &mut dyn Write,
+) -> anyhow::Result<usize> {
     let mut report = |o: &TestOutcome| {
         let ms = o.duration.as_secs_f64() * 1e3;
         let _ = match &o.failure {
@@ -103,20 +128,143 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             ),
         };
     };
-    let outcomes = run_tests(&cases, &options, &mut report);
+    let outcomes = run_tests(cases, options, &mut report);
     let failed = outcomes.iter().filter(|o| o.failure.is_some()).count();
     let passed = outcomes.len() - failed;
-    if let Some(path) = &args.junit {
+    if let Some(path) = junit {
         std::fs::write(path, junit_xml(&outcomes))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     writeln!(out, "{passed} passed, {failed} failed")?;
-    anyhow::ensure!(
-        failed == 0,
-        "{failed} script test{} failed",
-        if failed == 1 { "" } else { "s" }
-    );
-    Ok(())
+    out.flush()?;
+    Ok(failed)
+}
+
+/// `test --watch`: waits for edits of the test files and the script files beside them, and
+/// re-runs the tests each edit affects, until a stop signal.
+fn watch_tests(
+    args: &TestArgs,
+    files: &[PathBuf],
+    options: &TestOptions,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    super::record::watch_signals();
+    let mut watch = super::watch::Watch::new()?;
+    let watched = beside(files);
+    watch.add(&watched)?;
+    loop {
+        eprintln!(
+            "test --watch: watching {} script files; an edit re-runs the tests it affects (Ctrl-C to stop)",
+            watch.len()
+        );
+        let Some(changed) = watch.wait() else {
+            eprintln!("test --watch: stopped");
+            return Ok(());
+        };
+        let changed: Vec<String> = changed.into_iter().map(|(file, _)| file).collect();
+        let affected = affected(files, &changed);
+        let mut cases = discover(&affected, args.filter.as_deref());
+        if let Some(shard) = args.shard {
+            cases = shard.select(cases);
+        }
+        writeln!(
+            out,
+            "-- {} changed: {} tests in {}",
+            changed.join(", "),
+            cases.len(),
+            show_paths(&affected)
+        )?;
+        run_cases(&cases, options, args.junit.as_deref(), out)?;
+    }
+}
+
+/// The test files, and the script files a test may load beside them: each test folder's own,
+/// its `kinds/` and `scenes/`, those of its parent (`../kinds`, `../scenes`), and
+/// `scripts/kinds`.
+fn beside(files: &[PathBuf]) -> Vec<critterbox::scenes::SourceFile> {
+    let mut dirs = std::collections::BTreeSet::new();
+    dirs.insert(PathBuf::from("scripts/kinds"));
+    for f in files {
+        let dir = f.parent().unwrap_or(std::path::Path::new("."));
+        for d in [dir.to_path_buf(), dir.join("kinds"), dir.join("scenes")] {
+            dirs.insert(d);
+        }
+        if let Some(up) = dir.parent() {
+            dirs.insert(up.join("kinds"));
+            dirs.insert(up.join("scenes"));
+        }
+    }
+    let mut paths: std::collections::BTreeSet<PathBuf> = files.iter().cloned().collect();
+    for d in dirs {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "rhai") {
+                paths.insert(p);
+            }
+        }
+    }
+    paths
+        .into_iter()
+        .map(|p| critterbox::scenes::SourceFile {
+            path: p.display().to_string(),
+            text: String::new(),
+        })
+        .collect()
+}
+
+/// The test files an edit of `changed` affects: a changed test file itself; for any other
+/// script, the test files whose text names it (its file name, or its stem in quotes, as kinds
+/// and scenes are named), directly or through a scene file that names it; all of them when
+/// none does.
+fn affected(files: &[PathBuf], changed: &[String]) -> Vec<PathBuf> {
+    let same =
+        |f: &PathBuf, c: &str| std::fs::canonicalize(f).ok() == std::fs::canonicalize(c).ok();
+    let text = |p: &std::path::Path| std::fs::read_to_string(p).unwrap_or_default();
+    let names = |c: &str, t: &str| {
+        let p = std::path::Path::new(c);
+        let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned());
+        let name = p.file_name().map(|s| s.to_string_lossy().into_owned());
+        stem.is_some_and(|s| t.contains(&format!("\"{s}\"")))
+            || name.is_some_and(|n| t.contains(&n))
+    };
+    let mut out = Vec::new();
+    for f in files {
+        let t = text(f);
+        let hit = changed.iter().any(|c| {
+            same(f, c) || names(c, &t) || scenes_named(f, &t).iter().any(|s| names(c, &text(s)))
+        });
+        if hit {
+            out.push(f.clone());
+        }
+    }
+    if out.is_empty() {
+        return files.to_vec();
+    }
+    out
+}
+
+/// The scene files a test file's text names (by file name, beside it or in `../scenes`).
+fn scenes_named(test: &std::path::Path, text: &str) -> Vec<PathBuf> {
+    let dir = test.parent().unwrap_or(std::path::Path::new("."));
+    let mut found = Vec::new();
+    for d in [dir.join("scenes"), dir.join("../scenes"), dir.to_path_buf()] {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            let named = p
+                .file_name()
+                .is_some_and(|n| text.contains(&*n.to_string_lossy()));
+            if p.extension().is_some_and(|x| x == "rhai") && named && p != test {
+                found.push(p);
+            }
+        }
+    }
+    found
 }
 
 fn parse_shard(s: &str) -> Result<Shard, String> {

@@ -92,6 +92,16 @@ impl Viewer {
         let _ = (world, step_time);
     }
 
+    /// Shows `line` in the viewer's log with the next step (a kind reloaded, `run --watch`).
+    pub fn note(&mut self, line: String) {
+        #[cfg(feature = "rerun")]
+        if let Some(sink) = &mut self.sink {
+            sink.note(line);
+        }
+        #[cfg(not(feature = "rerun"))]
+        let _ = line;
+    }
+
     /// Finishes; returns the time taken from the simulation thread and the steps a live
     /// viewer skipped, and prints a warning if a live viewer never took the data.
     pub fn finish(self) -> Option<(Duration, u64)> {
