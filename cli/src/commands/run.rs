@@ -230,11 +230,10 @@ pub fn run_once(
             }
             let changed = w.changed();
             let file = scene_file.as_deref();
-            let edits = match changed.is_empty() {
-                true => Edits::Applied,
-                false => {
-                    bar.suspend(|| apply(changed, &mut scene, &mut recorder, &mut viewer, file))?
-                }
+            let edits = if changed.is_empty() {
+                Edits::Applied
+            } else {
+                bar.suspend(|| apply(changed, &mut scene, &mut recorder, &mut viewer, file))?
             };
             if edits == Edits::SceneChanged {
                 let reason = "its scene file changed (--watch)".to_string();

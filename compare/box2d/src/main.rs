@@ -26,7 +26,7 @@ critterbox against Box2D v3 (boxdd) on the standard 2D gas and a ball pit, in on
 
 Usage: critterbox-vs-box2d [--scene gas|pit|both] [--n LIST] [--threads LIST] [--rounds R]
                            [--steps S] [--warmup W] [--drift-steps D] [--substeps K]
-                           [--settle SECONDS]
+                           [--settle SECONDS] [--solve N]
 
   --scene S        gas, pit or both (default both)
   --n LIST         critter counts, comma separated, 1e5 accepted (default 1000,10000,100000 for
@@ -42,7 +42,8 @@ Usage: critterbox-vs-box2d [--scene gas|pit|both] [--n LIST] [--threads LIST] [-
                    least the warm-up and the rounds (default 600)
   --substeps K     Box2D's substeps per step (default 4, its recommended count)
   --settle T       pit: seconds of settling before the later rounds (default: the fall time from
-                   the top of the start to the floor, plus 10 s)";
+                   the top of the start to the floor, plus 10 s)
+  --solve N        pit: the sweeps of the solve:N set-up beside auto (default 8)";
 
 /// The command line.
 pub struct Args {
@@ -55,6 +56,8 @@ pub struct Args {
     pub drift_steps: usize,
     pub substeps: i32,
     pub settle: Option<f64>,
+    /// The sweeps of the pit's `solve:N` set-up.
+    pub solve: u32,
 }
 
 /// Which scenes to run.
@@ -88,6 +91,7 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
         drift_steps: 600,
         substeps: 4,
         settle: None,
+        solve: 8,
     };
     while let Some(flag) = args.next() {
         let mut value = || args.next().ok_or(format!("{flag} needs a value"));
@@ -125,6 +129,7 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
             "--substeps" => {
                 a.substeps = i32::try_from(number(value()?)?).map_err(|e| e.to_string())?
             }
+            "--solve" => a.solve = u32::try_from(number(value()?)?).map_err(|e| e.to_string())?,
             "--settle" => {
                 let t = value()?.parse::<f64>().ok().filter(|t| *t >= 0.0);
                 a.settle = Some(t.ok_or("--settle needs seconds, 0 or more")?);

@@ -176,7 +176,7 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
             .unwrap_or((2.0 * l.height / GRAVITY).sqrt() + SETTLE_AFTER_FALL);
         let settle_steps = (settle / DT).round() as usize;
         for (threads, pool) in pools {
-            let (auto, solve): (Method, Method) = ("auto".parse()?, "solve:8".parse()?);
+            let (auto, solve) = (Method::Auto, Method::Solve(args.solve));
             let first = world(n, auto)?;
             let scene = Bodies::of(&first);
             let settings = Settings {
@@ -209,7 +209,8 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
                         .collect();
                     eprintln!(
                         "pit N = {n}, {threads} thread(s): {done}/{settle_steps} steps settled, \
-                         ms/step so far (auto, solve:8, Box2D): {}",
+                         ms/step so far (auto, solve:{}, Box2D): {}",
+                        args.solve,
                         so_far.join(", ")
                     );
                 }
