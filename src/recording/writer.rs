@@ -230,6 +230,8 @@ impl Recorder {
         kinds: Vec<String>,
     ) -> Result<(), RecordingError> {
         let step = world.step_count();
+        // The next step's record carries the kind table again: a kind's colour may have changed.
+        self.known_kinds = 0;
         let msg = ReloadMsg {
             step,
             time: Float(world.time()),
