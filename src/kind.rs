@@ -215,6 +215,29 @@ pub struct Kind<V: Vector> {
     pub(crate) rule_depends_on_state: bool,
 }
 
+impl<V: Vector> Kind<V> {
+    /// A kind, with what its hooks do read once.
+    fn new(
+        name: String,
+        parent: Option<KindId>,
+        defaults: KindDefaults,
+        hooks: Rc<dyn KindHooks<V>>,
+    ) -> Self {
+        Kind {
+            name,
+            parent,
+            has_update: hooks.has_update(),
+            has_init: hooks.has_init(),
+            has_collide: hooks.has_collide(),
+            has_touch_hooks: hooks.has_touch_hooks(),
+            has_on_death: hooks.has_on_death(),
+            rule_depends_on_state: hooks.rule_depends_on_state(),
+            defaults,
+            hooks,
+        }
+    }
+}
+
 /// The kinds of a world. Always holds `ball` and `wall`.
 pub struct KindSet<V: Vector> {
     kinds: Vec<Kind<V>>,
@@ -264,18 +287,8 @@ impl<V: Vector> KindSet<V> {
         self.by_name.insert(name.to_string(), id);
         self.tracks_touch |= hooks.tracks_touch();
         self.has_on_death |= hooks.has_on_death();
-        self.kinds.push(Kind {
-            name: name.to_string(),
-            parent,
-            has_update: hooks.has_update(),
-            has_init: hooks.has_init(),
-            has_collide: hooks.has_collide(),
-            has_touch_hooks: hooks.has_touch_hooks(),
-            has_on_death: hooks.has_on_death(),
-            rule_depends_on_state: hooks.rule_depends_on_state(),
-            defaults,
-            hooks,
-        });
+        self.kinds
+            .push(Kind::new(name.to_string(), parent, defaults, hooks));
         id
     }
 
@@ -330,19 +343,7 @@ impl<V: Vector> KindSet<V> {
             });
         }
         check_defaults(&name, &defaults)?;
-        let kind = &mut self.kinds[id.0 as usize];
-        *kind = Kind {
-            name,
-            parent,
-            has_update: hooks.has_update(),
-            has_init: hooks.has_init(),
-            has_collide: hooks.has_collide(),
-            has_touch_hooks: hooks.has_touch_hooks(),
-            has_on_death: hooks.has_on_death(),
-            rule_depends_on_state: hooks.rule_depends_on_state(),
-            defaults,
-            hooks,
-        };
+        self.kinds[id.0 as usize] = Kind::new(name, parent, defaults, hooks);
         self.tracks_touch = self.kinds.iter().any(|k| k.hooks.tracks_touch());
         self.has_on_death = self.kinds.iter().any(|k| k.has_on_death);
         Ok(())
