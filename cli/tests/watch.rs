@@ -194,3 +194,24 @@ fn test_watch_reruns_only_the_tests_an_edit_affects() {
     let status = child.wait().expect("ends");
     assert_eq!(status.code(), Some(0), "Ctrl-C ends the watch: {seen:#?}");
 }
+
+#[test]
+fn a_built_in_scene_has_nothing_to_watch_and_the_watch_ends() {
+    let dir = common::tmp_in("watch-tests", "builtin");
+    let out = common::critterbox_in(
+        &dir,
+        &[
+            "run",
+            "gas",
+            "-n",
+            "20",
+            "--steps",
+            "5",
+            "--no-record",
+            "--watch",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("nothing to watch"), "{err}");
+}

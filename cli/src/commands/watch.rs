@@ -192,6 +192,10 @@ pub fn run_watching(args: &RunArgs, out: &mut dyn Write) -> anyhow::Result<()> {
             Err(e) if watch.len() == 0 => return Err(e),
             Err(e) => eprintln!("error: {e:#}"),
         }
+        if watch.len() == 0 {
+            eprintln!("watch: this scene loads no script files, so there is nothing to watch");
+            return Ok(());
+        }
         eprintln!(
             "watch: watching {} script file{} for edits; an edit runs the scene again (Ctrl-C to stop)",
             watch.len(),
