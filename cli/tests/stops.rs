@@ -9,7 +9,7 @@ use critterbox::recording::verify::verify;
 use critterbox::recording::{Recording, SETUP_FAILED};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// A fresh folder for one test.
 fn tmp(name: &str) -> PathBuf {
@@ -29,15 +29,7 @@ fn interrupt_with(signal: &str, number: i32) {
         .spawn()
         .expect("spawn");
     // The signals are watched before the file is created, so once it exists they are caught.
-    let start = Instant::now();
-    while std::fs::metadata(&file).map_or(0, |m| m.len()) == 0 {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the run never wrote"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    common::wait_until_stepping(&file);
     let sent = Command::new("kill")
         .args([&format!("-{signal}"), &child.id().to_string()])
         .status()

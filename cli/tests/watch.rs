@@ -69,15 +69,7 @@ fn an_edited_kind_is_reloaded_recorded_and_verified_and_a_scene_edit_restarts() 
         }
     });
     // Stepping once the recording has started.
-    let start = Instant::now();
-    while std::fs::metadata(&file).map_or(0, |m| m.len()) == 0 {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the run never wrote"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    common::wait_until_stepping(&file);
     let kind = dir.join("kinds/mover.rhai");
     let mut seen = Vec::new();
     std::fs::write(&kind, KIND.replace("vec(1.0, 0.0)", "vec(0.0, 1.0)")).expect("edit");

@@ -41,3 +41,17 @@ pub fn text(o: &Output) -> String {
         String::from_utf8_lossy(&o.stderr)
     )
 }
+
+/// Waits (up to a minute) until a run started in the background has written to its recording
+/// `file`, then a little longer, so that it is stepping.
+pub fn wait_until_stepping(file: &Path) {
+    let start = std::time::Instant::now();
+    while std::fs::metadata(file).map_or(0, |m| m.len()) == 0 {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "the run never wrote"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+}
