@@ -447,9 +447,9 @@ const MOST_PAIRS_TESTED: usize = 1 << 14;
 const SORTED_MEMBERS: usize = 32;
 
 /// Joins the islands of `parent` that hold two disks within their reaches; true when some
-/// joined. Each island's box (its disks' centres widened by radius and reach) is swept along x
-/// against the others' (a border that does not wrap), so only islands whose boxes meet are
-/// tested disk by disk; the joins are made after the sweep, in the order found.
+/// joined. Only islands whose boxes (their disks' centres widened by radius and reach, in a
+/// border that does not wrap) meet are tested disk by disk ([`box_pairs::meeting`]); the joins
+/// are made after all the tests, and each set's root is its lowest disk whatever their order.
 fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
     let n = disks.len();
     // Per root: its box and its disks (a counting sort by root).
@@ -502,56 +502,47 @@ fn link_islands<V: Vector>(disks: &[Disk<V>], parent: &mut [u32]) -> bool {
         let gap = (dq.pos - dp.pos).length() - dp.radius - dq.radius;
         gap <= dp.reach + dq.reach
     };
-    let mut roots: Vec<usize> = (0..n).filter(|&r| count[r + 1] > count[r]).collect();
-    roots.sort_by(|&a, &b| lo[a].get(0).total_cmp(&lo[b].get(0)).then(a.cmp(&b)));
-    let meet = |a: usize, b: usize| {
-        (0..V::DIM).all(|ax| lo[a].get(ax) <= hi[b].get(ax) && lo[b].get(ax) <= hi[a].get(ax))
-    };
+    let roots: Vec<usize> = (0..n).filter(|&r| count[r + 1] > count[r]).collect();
     let mut joins = Vec::new();
-    for (i, &a) in roots.iter().enumerate() {
-        for &b in &roots[i + 1..] {
-            if lo[b].get(0) > hi[a].get(0) {
-                break;
-            }
-            if !(awake[a] || awake[b]) || !meet(a, b) {
-                continue;
-            }
-            let (da, db) = (
-                &members[count[a]..count[a + 1]],
-                &members[count[b]..count[b + 1]],
-            );
-            let (big, small, large) = if da.len() >= db.len() {
-                (da, db, a)
+    for (a, b) in box_pairs::meeting(&roots, &lo, &hi) {
+        if !(awake[a] || awake[b]) {
+            continue;
+        }
+        let (da, db) = (
+            &members[count[a]..count[a + 1]],
+            &members[count[b]..count[b + 1]],
+        );
+        let (big, small, large) = if da.len() >= db.len() {
+            (da, db, a)
+        } else {
+            (db, da, b)
+        };
+        // The pair in `a`, `b` order, so each gap rounds as the plain test's does.
+        let in_order = |p: usize, q: usize| {
+            if large == a {
+                within(p, q)
             } else {
-                (db, da, b)
-            };
-            // The pair in `a`, `b` order, so each gap rounds as the plain test's does.
-            let in_order = |p: usize, q: usize| {
-                if large == a {
-                    within(p, q)
-                } else {
-                    within(q, p)
-                }
-            };
-            let near = da.len() * db.len() > MOST_PAIRS_TESTED
-                || if big.len() > SORTED_MEMBERS {
-                    small.iter().any(|&q| {
-                        let x = disks[q].pos.get(0);
-                        // A margin over rounding, so that the window holds every pair within.
-                        let w = disks[q].radius + disks[q].reach + widest[large];
-                        let w = w + 1e-9 * (1.0 + x.abs() + w);
-                        let from = big.partition_point(|&p| disks[p].pos.get(0) < x - w);
-                        big[from..]
-                            .iter()
-                            .take_while(|&&p| disks[p].pos.get(0) <= x + w)
-                            .any(|&p| in_order(p, q))
-                    })
-                } else {
-                    da.iter().any(|&p| db.iter().any(|&q| within(p, q)))
-                };
-            if near {
-                joins.push((a, b));
+                within(q, p)
             }
+        };
+        let near = da.len() * db.len() > MOST_PAIRS_TESTED
+            || if big.len() > SORTED_MEMBERS {
+                small.iter().any(|&q| {
+                    let x = disks[q].pos.get(0);
+                    // A margin over rounding, so that the window holds every pair within.
+                    let w = disks[q].radius + disks[q].reach + widest[large];
+                    let w = w + 1e-9 * (1.0 + x.abs() + w);
+                    let from = big.partition_point(|&p| disks[p].pos.get(0) < x - w);
+                    big[from..]
+                        .iter()
+                        .take_while(|&&p| disks[p].pos.get(0) <= x + w)
+                        .any(|&p| in_order(p, q))
+                })
+            } else {
+                da.iter().any(|&p| db.iter().any(|&q| within(p, q)))
+            };
+        if near {
+            joins.push((a, b));
         }
     }
     for &(a, b) in &joins {
@@ -716,5 +707,6 @@ fn union(parent: &mut [u32], a: usize, b: usize) {
     }
 }
 
+mod box_pairs;
 #[cfg(test)]
 mod tests;

@@ -64,6 +64,10 @@ pub(crate) struct Sleep<V> {
     still: Vec<bool>,
     /// How many sleepers there are.
     sleepers: usize,
+    /// Whether the last [`Sleep::check`] found every critter a live wall or a sleeper.
+    all_still: bool,
+    /// Whether critters were removed since [`Sleep::take_removed`] last asked.
+    removed: bool,
     /// Slots a `collide` hook took this step.
     stirred: Vec<u32>,
     /// Islands to wake at the next [`Sleep::flush`].
@@ -125,6 +129,7 @@ impl<V: Vector> Sleep<V> {
         self.rest.clear();
         self.still.clear();
         self.sleepers = 0;
+        self.all_still = false;
         self.stirred.clear();
         self.waking.clear();
     }
@@ -144,6 +149,7 @@ impl<V: Vector> Sleep<V> {
         if self.waking.is_empty() {
             return;
         }
+        self.all_still = false;
         self.waking.sort_unstable();
         self.waking.dedup();
         for i in 0..self.quiet.len() {
@@ -218,14 +224,17 @@ impl<V: Vector> Sleep<V> {
     /// their islands), and fits the arrays to the slots.
     pub(crate) fn check(&mut self, slots: &[Option<Critter<V>>]) {
         self.stirred.clear();
+        self.all_still = false;
         if self.quiet.len() != slots.len() {
             self.fit(slots);
         }
         if self.sleepers == 0 {
             return;
         }
+        let mut all_still = true;
         for (i, c) in slots.iter().enumerate() {
             if !self.asleep(i) {
+                all_still &= c.as_ref().is_none_or(|c| c.alive && c.is_wall());
                 continue;
             }
             let (pos, radius) = self.rest[i];
@@ -236,7 +245,19 @@ impl<V: Vector> Sleep<V> {
                 self.wake(i);
             }
         }
+        self.all_still = all_still && self.waking.is_empty();
         self.flush();
+    }
+
+    /// Whether critters were removed since the last call.
+    pub(crate) fn take_removed(&mut self) -> bool {
+        std::mem::take(&mut self.removed)
+    }
+
+    /// True when the last [`Sleep::check`] found every critter a live wall or a sleeper and
+    /// woke none: the step has nothing to move, test or solve.
+    pub(crate) fn all_still(&self) -> bool {
+        self.all_still
     }
 
     /// At the end of a `solve:n` step: wakes the islands touched by moving critters, then counts
@@ -384,6 +405,7 @@ impl<V: Vector> Sleep<V> {
         if self.quiet.is_empty() {
             return;
         }
+        self.removed |= !gone.is_empty();
         for &(slot, _, _) in gone {
             self.wake(slot);
         }

@@ -145,6 +145,8 @@ pub(crate) struct Scratch<V> {
     keys: Vec<u64>,
     /// Velocity sweeps the last solve took (0 with no contacts).
     pub(crate) swept: u32,
+    /// Whether the last step was [`rest`]'s: every kept impulse is of two still critters.
+    rested: bool,
     graph: Graph,
     /// The last step's accumulated impulses by pair key, ascending: the only state the solve
     /// carries from one step to the next (recorded with every full state).
@@ -164,6 +166,7 @@ impl<V> Default for Scratch<V> {
             plain: Vec::new(),
             keys: Vec::new(),
             swept: 0,
+            rested: false,
             graph: Graph::default(),
             warm: Vec::new(),
         }
@@ -181,6 +184,7 @@ pub(crate) fn respond<V: Vector>(
     h: f64,
 ) -> Result<usize, Error> {
     let mut handled = 0;
+    s.rested = false;
     // 1. The hooks, disk pairs then wall pairs, in the discrete step's order.
     s.plain.clear();
     let plain = &mut s.plain;
@@ -427,6 +431,24 @@ pub(crate) fn respond<V: Vector>(
         sleep.after_solve(state.critters.slots_mut_moving(), &pairs.contacts, speed);
     }
     Ok(handled + s.rows.len())
+}
+
+/// The solve's part of a step in which every critter sleeps or is a wall: no row, and of the
+/// kept impulses those of two still critters (what [`respond`] keeps when it has no row).
+/// `removed` tells whether critters were removed since the last step.
+pub(crate) fn rest<V: Vector>(s: &mut Scratch<V>, sleep: &Sleep<V>, removed: bool) {
+    s.swept = 0;
+    // After a step like this one, only a removal can make a kept pair's critter not still.
+    let filtered = std::mem::replace(&mut s.rested, true);
+    if filtered && !removed {
+        return;
+    }
+    let still = sleep.still();
+    let is_still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
+    s.warm.retain(|&(key, _)| {
+        let (lo, hi) = unpair_key(key);
+        is_still(lo) && is_still(hi)
+    });
 }
 
 /// Calls `caller`'s own `collide` on the pair (counted in `handled` when it touched), or

@@ -40,6 +40,9 @@ pub(crate) struct MethodState<V: Vector> {
     sleep: Sleep<V>,
     /// The run was told once that a discrete step moved a critter farther than its radius.
     warned_tunnel: bool,
+    /// Steps in which every critter sleeps or is a wall are skipped (tests turn it off to
+    /// compare with the full step).
+    rest_shortcut: bool,
 }
 
 /// What a step is taken with (under `auto`, what it chose for this step).
@@ -75,6 +78,7 @@ impl<V: Vector> MethodState<V> {
             solve: Default::default(),
             sleep: Sleep::new(sleep),
             warned_tunnel: false,
+            rest_shortcut: true,
         }
     }
 
@@ -400,6 +404,16 @@ impl<V: Vector> MethodState<V> {
             }
             Method::Swept => swept::step(state, pairs, &mut self.flight, plan.per_critter, stats),
             Method::Event => event::step(state, pairs, &mut self.flight, stats),
+            Method::Solve(_)
+                if self.rest_shortcut && self.sleep.active && self.sleep.all_still() =>
+            {
+                // Everyone sleeps: nothing moves, and every pair is two sleepers or a sleeper
+                // and a wall, which the step would skip one by one.
+                pairs.forget_found();
+                let removed = self.sleep.take_removed();
+                solve::rest(&mut self.solve, &self.sleep, removed);
+                Ok(())
+            }
             Method::Solve(n) => {
                 let mut respond = Respond::Solve {
                     scratch: &mut self.solve,
@@ -432,6 +446,12 @@ impl<V: Vector> MethodState<V> {
     }
 
     // ----- sleep ------------------------------------------------------------------------------
+
+    /// Takes the full step even when every critter sleeps.
+    #[cfg(test)]
+    pub(crate) fn no_rest_shortcut(&mut self) {
+        self.rest_shortcut = false;
+    }
 
     /// Lets critters sleep under `solve:n`, or keeps every one awake (and wakes the sleepers).
     pub(crate) fn set_sleep(&mut self, on: bool) {

@@ -111,3 +111,74 @@ fn critters_that_differ_in_any_trait_do_not_share() {
     let (ta, tb) = (&w.get(a).expect("a").traits, &w.get(b).expect("b").traits);
     assert!(Arc::ptr_eq(ta, tb));
 }
+
+/// A small pit of `solve:8` disks in a walled box; the same every call.
+fn pit() -> World<DVec2> {
+    use crate::wall::WallBox;
+    let config = WorldConfig::new(DVec2::splat(-2.0), DVec2::new(22.0, 22.0))
+        .dt(1.0 / 60.0)
+        .gravity(DVec2::new(0.0, -9.81))
+        .seed(3)
+        .method(crate::method::Method::Solve(8));
+    let mut w = World::new(config).expect("the pit's world");
+    for (lo, hi) in [
+        ((-1.0, -1.0), (21.0, 0.0)),
+        ((-1.0, 0.0), (0.0, 20.0)),
+        ((20.0, 0.0), (21.0, 20.0)),
+    ] {
+        let wall = WallBox::aligned(DVec2::from(lo), DVec2::from(hi)).expect("a wall");
+        w.add_wall(wall).expect("the wall joins");
+    }
+    for i in 0..120 {
+        let shift = w.rng().uniform(-0.1, 0.1);
+        let pos = DVec2::new(
+            1.0 + 1.25 * (i % 15) as f64 + shift,
+            1.0 + 1.25 * (i / 15) as f64,
+        );
+        w.spawn(CritterSpec::ball(pos).radius(0.5).restitution(0.5))
+            .expect("a disk");
+    }
+    w
+}
+
+/// Steps in which every critter sleeps skip the step's stages: the run is the full step's,
+/// bit for bit, through falling asleep, a sleeper pushed awake, and a sleeper removed.
+#[test]
+fn a_pit_asleep_skips_its_steps_and_stays_the_full_step_s_run() {
+    let (mut short, mut full) = (pit(), pit());
+    full.methods.no_rest_shortcut();
+    let movers = short.critters().iter().filter(|c| !c.is_wall()).count();
+    let mut all_asleep = 0;
+    let top = |w: &World<DVec2>| {
+        let disks = w.critters().iter().filter(|c| !c.is_wall());
+        disks
+            .max_by(|a, b| a.pos.y.total_cmp(&b.pos.y))
+            .expect("disks")
+            .id()
+    };
+    for step in 0..2400 {
+        if step == 1200 {
+            for w in [&mut short, &mut full] {
+                let id = top(w);
+                w.get_mut(id).expect("the top disk").vel = DVec2::new(1.0, 2.0);
+            }
+        }
+        if step == 1800 {
+            for w in [&mut short, &mut full] {
+                let id = top(w);
+                w.remove(id).expect("the top disk goes");
+            }
+        }
+        short.step().expect("steps");
+        full.step().expect("steps");
+        assert_eq!(short.state_hash(), full.state_hash(), "step {step}");
+        let counts = |w: &World<DVec2>| {
+            let t = w.totals();
+            (t.contacts, t.collisions, t.impacts)
+        };
+        assert_eq!(counts(&short), counts(&full), "step {step}");
+        all_asleep += usize::from(short.sleepers() + usize::from(step >= 1800) == movers);
+    }
+    // The shortcut was taken, before and after each disturbance.
+    assert!(all_asleep > 600, "all asleep in {all_asleep} steps");
+}

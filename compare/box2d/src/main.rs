@@ -26,7 +26,7 @@ critterbox against Box2D v3 (boxdd) on the standard 2D gas and a ball pit, in on
 
 Usage: critterbox-vs-box2d [--scene gas|pit|both] [--n LIST] [--threads LIST] [--rounds R]
                            [--steps S] [--warmup W] [--drift-steps D] [--substeps K]
-                           [--settle SECONDS] [--solve N]
+                           [--settle SECONDS] [--rest-within SECONDS] [--solve N]
 
   --scene S        gas, pit or both (default both)
   --n LIST         critter counts, comma separated, 1e5 accepted (default 1000,10000,100000 for
@@ -43,6 +43,9 @@ Usage: critterbox-vs-box2d [--scene gas|pit|both] [--n LIST] [--threads LIST] [-
   --substeps K     Box2D's substeps per step (default 4, its recommended count)
   --settle T       pit: seconds of settling before the later rounds (default: the fall time from
                    the top of the start to the floor, plus 10 s)
+  --rest-within T  pit: after the settling, seconds a set-up whose disks are not all asleep
+                   steps on (untimed) until they are, before the rounds at rest (default 30;
+                   0 measures right after the settling)
   --solve N        pit: the sweeps of the solve:N set-up beside auto (default 8)";
 
 /// The command line.
@@ -56,6 +59,8 @@ pub struct Args {
     pub drift_steps: usize,
     pub substeps: i32,
     pub settle: Option<f64>,
+    /// Pit: seconds of untimed steps, after the settling, for the piles to fall asleep.
+    pub rest_within: f64,
     /// The sweeps of the pit's `solve:N` set-up.
     pub solve: u32,
 }
@@ -91,6 +96,7 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
         drift_steps: 600,
         substeps: 4,
         settle: None,
+        rest_within: 30.0,
         solve: 8,
     };
     while let Some(flag) = args.next() {
@@ -133,6 +139,10 @@ fn parse(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
             "--settle" => {
                 let t = value()?.parse::<f64>().ok().filter(|t| *t >= 0.0);
                 a.settle = Some(t.ok_or("--settle needs seconds, 0 or more")?);
+            }
+            "--rest-within" => {
+                let t = value()?.parse::<f64>().ok().filter(|t| *t >= 0.0);
+                a.rest_within = t.ok_or("--rest-within needs seconds, 0 or more")?;
             }
             other => return Err(format!("unknown argument {other:?}")),
         }

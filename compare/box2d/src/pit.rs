@@ -12,8 +12,10 @@
 //! bounce) instead of its 1 m/s. Both engines let bodies at rest sleep.
 //!
 //! Timing: while the pit settles, the set-ups take turns of `--steps` steps, and the mean over
-//! the settling steps is reported; then `--rounds` alternating rounds of `--steps` steps after
-//! it (at rest, if the pile has come to rest by then), whose median is reported. At the end, both
+//! the settling steps is reported. A set-up whose disks are not all asleep then steps on,
+//! untimed, for up to `--rest-within` seconds until they are (the table gives when each pile
+//! was first all asleep). Then `--rounds` alternating rounds of `--steps` steps, whose median is
+//! reported: at rest for every pile that came to rest. At the end, both
 //! engines are measured alike (`bodies.rs`): the deepest overlap, the kinetic energy left and the
 //! disks outside the box.
 //!
@@ -160,15 +162,16 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
          row) into a box closed by walls, gravity {GRAVITY}, dt = 1/60, restitution \
          {RESTITUTION}, friction 0, sleep on in both. Box2D: {} substeps, restitution threshold \
          {threshold:.3} m/s (critterbox's resting speed, 2 |g| dt). Settling: mean ms/step over \
-         the settling steps, taken in turns of {} steps. After settling: median of {} alternating \
-         rounds of {} steps (at rest where the asleep column has every disk). Then, measured \
+         the settling steps, taken in turns of {} steps. A pile not all asleep then steps on \
+         untimed, up to {} s, until it is. At rest: median of {} alternating rounds of {} steps \
+         (at rest where the asleep column has every disk). Then, measured \
          alike for both: the deepest overlap (disk-disk in radii of the smaller, disk-wall in \
          the disk's), the kinetic energy left over N m g r, disks asleep and disks outside the \
          box.\n",
-        args.substeps, args.steps, args.rounds, args.steps
+        args.substeps, args.steps, args.rest_within, args.rounds, args.steps
     );
-    println!("| N | threads | engine | settle steps | settling ms/step | after settling ms/step | deepest overlap (r) | KE / (N m g r) | asleep | outside |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| N | threads | engine | settle steps | settling ms/step | all asleep at (s) | at rest ms/step | deepest overlap (r) | KE / (N m g r) | asleep | outside |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         let l = Layout::of(n);
         let settle = args
@@ -192,11 +195,16 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
             ];
             // Settling: turns of `steps` steps, each set-up in turn, so a load spike hits all.
             let mut settling = vec![0.0; engines.len()];
+            // The step after which each set-up first had every disk asleep (to a turn).
+            let mut slept = vec![None; engines.len()];
             let mut done = 0;
             while done < settle_steps {
                 let turn = args.steps.min(settle_steps - done);
-                for (e, total) in engines.iter_mut().zip(&mut settling) {
+                for ((e, total), slept) in engines.iter_mut().zip(&mut settling).zip(&mut slept) {
                     *total += e.time(pool, turn) * turn as f64;
+                    if slept.is_none() && e.asleep()? == n {
+                        *slept = Some(done + turn);
+                    }
                 }
                 done += turn;
                 // Progress on stderr, about every tenth of the settling, for the large pits that
@@ -215,13 +223,27 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
                     );
                 }
             }
+            // Untimed: the set-ups still awake step on until they sleep, so that the rounds
+            // after settling find every pile at rest that comes to rest within the time given.
+            let rest_steps = (args.rest_within / DT).round() as usize;
+            for (e, slept) in engines.iter_mut().zip(&mut slept) {
+                let mut steps = done;
+                while slept.is_none() && steps < done + rest_steps {
+                    e.time(pool, args.steps);
+                    steps += args.steps;
+                    if e.asleep()? == n {
+                        *slept = Some(steps);
+                    }
+                }
+            }
             let mut at_rest = vec![Vec::new(); engines.len()];
             for _ in 0..args.rounds {
                 for (e, times) in engines.iter_mut().zip(&mut at_rest) {
                     times.push(e.time(pool, args.steps));
                 }
             }
-            for ((e, total), times) in engines.iter_mut().zip(settling).zip(at_rest) {
+            let zipped = engines.iter_mut().zip(settling).zip(at_rest).zip(slept);
+            for (((e, total), times), slept) in zipped {
                 let disks = e.disks()?;
                 let overlap = deepest_overlap(&disks, &scene.walls);
                 let ke = energy(&disks) / (n as f64 * GRAVITY * RADIUS);
@@ -231,8 +253,12 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
                 } else {
                     "-".into()
                 };
+                let slept = match slept {
+                    Some(steps) => format!("{:.1}", steps as f64 * DT),
+                    None => format!("> {:.0}", (settle_steps + rest_steps) as f64 * DT),
+                };
                 println!(
-                    "| {n} | {threads} | {} | {settle_steps} | {settling} | {:.3} | {overlap:.4} | {ke:.1e} | {} | {out} |",
+                    "| {n} | {threads} | {} | {settle_steps} | {settling} | {slept} | {:.3} | {overlap:.4} | {ke:.1e} | {} | {out} |",
                     e.name(),
                     median(times),
                     e.asleep()?,

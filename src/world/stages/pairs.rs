@@ -67,6 +67,16 @@ impl<V: Vector> Pairs<V> {
         }
     }
 
+    /// Lists no pair, as [`Pairs::find`] would in a step with nothing to test (no contact:
+    /// the list is not crowded).
+    pub(crate) fn forget_found(&mut self) {
+        self.broad.set_crowded(false);
+        self.candidates.clear();
+        self.ruled.clear();
+        self.contacts.clear();
+        self.wall_pairs.clear();
+    }
+
     /// What the move stage checks for this stage as it moves each critter.
     pub(crate) fn move_check(&self) -> MoveCheck<'_, V> {
         MoveCheck { broad: &self.broad }
