@@ -16,7 +16,7 @@ use super::{read_script, Runtime, SourceFile};
 use crate::error::{Error, ScriptError};
 use crate::kind::{KindDefaults, KindId};
 use crate::world::World;
-use rhai::{Map, Position, Scope, AST};
+use rhai::{FnCallCache, Map, Position, Scope, AST};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::rc::{Rc, Weak};
@@ -91,6 +91,9 @@ pub(crate) struct ScriptKindDef {
     hooks: [Option<Rc<HookFn>>; HOOKS.len()],
     /// The parent kind, when it is a script kind.
     pub(super) parent_def: Option<Rc<ScriptKindDef>>,
+    /// What the calls of its hooks resolved function names to, kept for the next calls: they
+    /// all run in `ast` with the one engine, so the answers stay right.
+    pub(super) calls: RefCell<FnCallCache>,
 }
 
 impl ScriptKindDef {
@@ -297,6 +300,7 @@ pub(crate) fn build(
             rule_depends_on_state,
             hooks,
             parent_def: parent.clone(),
+            calls: RefCell::new(FnCallCache::default()),
         }
     });
     Ok(def)

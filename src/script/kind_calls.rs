@@ -69,22 +69,14 @@ impl ScriptKind {
         let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
         // Timed per kind and hook when the profiler is on (`run --stats`, profile.rs).
         let profiler = &self.rt.profiler;
-        let result = profiler.time(&self.def.name, hook, || match f.scope.try_borrow_mut() {
-            Ok(mut scope) => self.rt.engine.call_fn_with_options::<Dynamic>(
-                options,
-                &mut scope,
-                &self.def.ast,
-                hook,
-                args,
-            ),
-            // A hook re-entered (a spawn's init inside another hook): use a fresh scope.
-            Err(_) => self.rt.engine.call_fn_with_options::<Dynamic>(
-                options,
-                &mut Scope::new(),
-                &self.def.ast,
-                hook,
-                args,
-            ),
+        let engine = &self.rt.engine;
+        let (scope, calls) = (f.scope.try_borrow_mut(), self.def.calls.try_borrow_mut());
+        let result = profiler.time(&self.def.name, hook, || match (scope, calls) {
+            (Ok(mut scope), Ok(mut calls)) => {
+                engine.call_fn_cached(&mut calls, options, &mut scope, &self.def.ast, hook, args)
+            }
+            // A hook re-entered (a spawn's init inside another hook): a fresh scope and cache.
+            _ => engine.call_fn_with_options(options, &mut Scope::new(), &self.def.ast, hook, args),
         });
         result.map_err(|e| {
             let mut err = eval_error(&f.file, Some(hook), f.line, &e, self.max_ops());

@@ -4,9 +4,10 @@
 //!
 //! One `Runtime` per run holds the engine (built once by `api::build_engine`), each kind's
 //! compiled AST, and the `Host` (`host.rs`) through which running scripts reach the world. Each
-//! hook is a plain `call_fn` on an AST compiled once, with the top level not re-run and no
-//! per-call scope allocation; a kind's hooks run only for pairs that really touch, and only for
-//! kinds that define them. A layer above (the script test runner, [`crate::testing`]) adds its
+//! hook is a `call_fn` on an AST compiled once, with the top level not re-run, no per-call scope
+//! allocation, and the functions it calls resolved once per kind (`call_fn_cached`, a patch of
+//! the vendored rhai); a kind's hooks run only for pairs that really touch, and only for kinds
+//! that define them. A layer above (the script test runner, [`crate::testing`]) adds its
 //! functions through an `Extension`; nothing here depends on it or on recordings.
 
 pub(crate) mod api;

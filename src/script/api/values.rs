@@ -116,13 +116,14 @@ pub(crate) fn vec_of(d: &Dynamic, what: &str) -> Res<DVec3> {
 
 /// A script value as a critter property.
 pub(crate) fn to_prop(d: &Dynamic) -> Res<PropValue> {
-    if let Some(b) = d.clone().try_cast::<bool>() {
+    // Scalars, what update hooks set every step, are read without a clone.
+    if let Ok(b) = d.as_bool() {
         return Ok(PropValue::Bool(b));
     }
-    if let Some(i) = d.clone().try_cast::<INT>() {
+    if let Ok(i) = d.as_int() {
         return Ok(PropValue::Int(i));
     }
-    if let Some(x) = d.clone().try_cast::<f64>() {
+    if let Ok(x) = d.as_float() {
         return Ok(PropValue::Float(x));
     }
     if let Some(s) = d.clone().try_cast::<ImmutableString>() {

@@ -304,6 +304,9 @@ pub use func::ScriptFnMetadata;
 
 #[cfg(not(feature = "no_function"))]
 pub use api::options::CallFnOptions;
+#[cfg(not(feature = "no_function"))]
+#[cfg(not(feature = "no_ast"))]
+pub use api::call_fn_cached::FnCallCache;
 
 /// Variable-sized array of [`Dynamic`] values.
 ///

@@ -19,6 +19,8 @@ pub mod register;
 #[cfg(not(feature = "no_ast"))]
 pub mod call_fn;
 
+pub mod call_fn_cached;
+
 pub mod options;
 
 #[cfg(not(feature = "no_ast"))]

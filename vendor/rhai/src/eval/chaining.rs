@@ -525,30 +525,33 @@ impl Engine {
 
                         if op_info.is_op_assignment() {
                             let args = &mut [target.as_mut()];
-
-                            let (mut orig_val, ..) = self
-                                .exec_native_fn_call(
-                                    global, caches, getter, None, *hash_get, args, is_ref_mut,
-                                    false, *pos,
-                                )
-                                .or_else(|err| match *err {
-                                    // Try an indexer if property does not exist
-                                    ERR::ErrorDotExpr(..) => {
-                                        let target = target.as_mut();
-                                        let mut prop = name.into();
-                                        self.call_indexer_get(
-                                            global, caches, target, &mut prop, op_pos,
-                                        )
-                                        .map(|r| (r, false))
-                                        .map_err(|e| {
-                                            match *e {
-                                                ERR::ErrorIndexingType(..) => err,
-                                                _ => e,
-                                            }
-                                        })
-                                    }
+                            let t0 = args[0].type_name();
+                            let found = self.exec_native_fn_call_or_none(
+                                global, caches, getter, None, *hash_get, args, is_ref_mut, false,
+                                *pos,
+                            );
+                            // Try an indexer if property does not exist; if neither exists, the
+                            // getter's error (made only then: a critterbox patch, see `PATCH.md`)
+                            let mut via_indexer = |err: Option<crate::RhaiError>| {
+                                let target = target.as_mut();
+                                let mut prop = name.into();
+                                self.call_indexer_get(global, caches, target, &mut prop, op_pos)
+                                    .map(|r| (r, false))
+                                    .map_err(|e| match *e {
+                                        ERR::ErrorIndexingType(..) => err.unwrap_or_else(|| {
+                                            self.getter_not_found(getter, t0, *pos)
+                                        }),
+                                        _ => e,
+                                    })
+                            };
+                            let (mut orig_val, ..) = match found {
+                                Ok(Some(r)) => Ok(r),
+                                Ok(None) => via_indexer(None),
+                                Err(err) => match *err {
+                                    ERR::ErrorDotExpr(..) => via_indexer(Some(err)),
                                     _ => Err(err),
-                                })?;
+                                },
+                            }?;
 
                             {
                                 let orig_val = &mut (&mut orig_val).try_into()?;
@@ -562,26 +565,34 @@ impl Engine {
                         }
 
                         let args = &mut [target.as_mut(), &mut new_val];
-
-                        self.exec_native_fn_call(
+                        let (t0, t1) = (args[0].type_name(), args[1].type_name());
+                        let found = self.exec_native_fn_call_or_none(
                             global, caches, setter, None, *hash_set, args, is_ref_mut, false, *pos,
-                        )
-                        .or_else(|err| match *err {
-                            // Try an indexer if property does not exist
-                            ERR::ErrorDotExpr(..) => {
-                                let target = target.as_mut();
-                                let idx = &mut name.into();
-                                let new_val = &mut new_val;
-                                self.call_indexer_set(
-                                    global, caches, target, idx, new_val, is_ref_mut, op_pos,
-                                )
-                                .map_err(|e| match *e {
-                                    ERR::ErrorIndexingType(..) => err,
-                                    _ => e,
-                                })
-                            }
-                            _ => Err(err),
-                        })
+                        );
+                        // Try an indexer if property does not exist; if neither exists, the
+                        // setter's error (made only then: a critterbox patch, see `PATCH.md`)
+                        let mut via_indexer = |err: Option<crate::RhaiError>| {
+                            let target = target.as_mut();
+                            let idx = &mut name.into();
+                            let new_val = &mut new_val;
+                            self.call_indexer_set(
+                                global, caches, target, idx, new_val, is_ref_mut, op_pos,
+                            )
+                            .map_err(|e| match *e {
+                                ERR::ErrorIndexingType(..) => err.unwrap_or_else(|| {
+                                    self.setter_not_found(setter, t0, t1, *pos)
+                                }),
+                                _ => e,
+                            })
+                        };
+                        match found {
+                            Ok(Some(r)) => Ok(r),
+                            Ok(None) => via_indexer(None),
+                            Err(err) => match *err {
+                                ERR::ErrorDotExpr(..) => via_indexer(Some(err)),
+                                _ => Err(err),
+                            },
+                        }
                     }
                     // xxx.id
                     (Expr::Property(x, pos), None, false) => {
@@ -590,28 +601,33 @@ impl Engine {
 
                         let ((getter, hash_get), _, name) = &**x;
                         let args = &mut [target.as_mut()];
-
-                        self.exec_native_fn_call(
+                        let t0 = args[0].type_name();
+                        let found = self.exec_native_fn_call_or_none(
                             global, caches, getter, None, *hash_get, args, is_ref_mut, false, *pos,
-                        )
-                        .map_or_else(
-                            |err| match *err {
-                                // Try an indexer if property does not exist
-                                ERR::ErrorDotExpr(..) => {
-                                    let target = target.as_mut();
-                                    let mut prop = name.into();
-                                    self.call_indexer_get(global, caches, target, &mut prop, op_pos)
-                                        .map(|r| (r, false))
-                                        .map_err(|e| match *e {
-                                            ERR::ErrorIndexingType(..) => err,
-                                            _ => e,
-                                        })
-                                }
+                        );
+                        // Try an indexer if property does not exist; if neither exists, the
+                        // getter's error (made only then: a critterbox patch, see `PATCH.md`)
+                        let mut via_indexer = |err: Option<crate::RhaiError>| {
+                            let target = target.as_mut();
+                            let mut prop = name.into();
+                            self.call_indexer_get(global, caches, target, &mut prop, op_pos)
+                                .map(|r| (r, false))
+                                .map_err(|e| match *e {
+                                    ERR::ErrorIndexingType(..) => err.unwrap_or_else(|| {
+                                        self.getter_not_found(getter, t0, *pos)
+                                    }),
+                                    _ => e,
+                                })
+                        };
+                        match found {
+                            // Assume getters are always pure
+                            Ok(Some((v, ..))) => Ok((v, false)),
+                            Ok(None) => via_indexer(None),
+                            Err(err) => match *err {
+                                ERR::ErrorDotExpr(..) => via_indexer(Some(err)),
                                 _ => Err(err),
                             },
-                            // Assume getters are always pure
-                            |(v, ..)| Ok((v, false)),
-                        )
+                        }
                     }
                     // {xxx:map}.sub_lhs[expr] | {xxx:map}.sub_lhs.expr
                     (Expr::Index(x, ..) | Expr::Dot(x, ..), new_val, true) => {

@@ -541,6 +541,36 @@ impl Engine {
         non_volatile_only: bool,
         pos: Position,
     ) -> RhaiResultOf<(Dynamic, bool)> {
+        match self.exec_native_fn_call_or_none(
+            global,
+            caches,
+            name,
+            op_token,
+            hash,
+            args,
+            is_ref_mut,
+            non_volatile_only,
+            pos,
+        )? {
+            Some(result) => Ok(result),
+            None => self.native_fn_not_found(name, args, pos),
+        }
+    }
+
+    /// [`Engine::exec_native_fn_call`], with `None` where no function is found, so a property
+    /// access can try an indexer before any error is made (a critterbox patch, see `PATCH.md`).
+    pub(crate) fn exec_native_fn_call_or_none(
+        &self,
+        global: &mut GlobalRuntimeState,
+        caches: &mut Caches,
+        name: &str,
+        op_token: Option<&Token>,
+        hash: u64,
+        args: &mut FnCallArgs,
+        is_ref_mut: bool,
+        non_volatile_only: bool,
+        pos: Position,
+    ) -> RhaiResultOf<Option<(Dynamic, bool)>> {
         self.track_operation(global, pos)?;
 
         // Check for data race.
@@ -549,7 +579,7 @@ impl Engine {
         ensure_no_data_race(name, args, is_ref_mut)?;
 
         if let Some(result) = self.exec_syntactic_fn_call(global, caches, name, args, pos)? {
-            return Ok((result, false));
+            return Ok(Some((result, false)));
         }
 
         // Check if function access already in the cache
@@ -656,7 +686,7 @@ impl Engine {
             }
 
             // See if the function match print/debug (which requires special processing)
-            return Ok(match name {
+            return Ok(Some(match name {
                 KEYWORD_PRINT => {
                     if let Some(ref print) = self.print {
                         let text = result.into_immutable_string().map_err(|typ| {
@@ -678,9 +708,19 @@ impl Engine {
                     (Dynamic::UNIT, false)
                 }
                 _ => (result, is_method),
-            });
+            }));
         }
 
+        Ok(None)
+    }
+
+    /// The error of a native function call that found no function.
+    fn native_fn_not_found<T>(
+        &self,
+        name: &str,
+        args: &FnCallArgs,
+        pos: Position,
+    ) -> RhaiResultOf<T> {
         // Error handling
         //
         // Note: we cannot use `assert!` here (e.g. to check for number of arguments) because
@@ -736,14 +776,7 @@ impl Engine {
                 )
                 .into()
                 } else {
-                    let t0 = self.map_type_name(args[0].type_name());
-                    ERR::ErrorDotExpr(
-                        format!(
-                        "Unknown property '{prop}' - a getter is not registered for type '{t0}'"
-                    ),
-                        pos,
-                    )
-                    .into()
+                    self.getter_not_found(name, args[0].type_name(), pos)
                 })
             }
 
@@ -761,15 +794,7 @@ impl Engine {
                 )
                 .into()
                 } else {
-                    let t0 = self.map_type_name(args[0].type_name());
-                    let t1 = self.map_type_name(args[1].type_name());
-                    ERR::ErrorDotExpr(
-                    format!(
-                        "No writable property '{prop}' - a setter is not registered for type '{t0}' to handle '{t1}'"
-                    ),
-                    pos,
-                )
-                .into()
+                    self.setter_not_found(name, args[0].type_name(), args[1].type_name(), pos)
                 })
             }
 
@@ -778,6 +803,44 @@ impl Engine {
                 Err(ERR::ErrorFunctionNotFound(self.gen_fn_call_signature(name, args), pos).into())
             }
         }
+    }
+
+    /// The error of getter `getter` (`get$prop`) missing for type `t0`.
+    #[cfg(not(feature = "no_object"))]
+    pub(crate) fn getter_not_found(
+        &self,
+        getter: &str,
+        t0: &str,
+        pos: Position,
+    ) -> crate::RhaiError {
+        let prop = &getter[crate::engine::FN_GET.len()..];
+        let t0 = self.map_type_name(t0);
+        ERR::ErrorDotExpr(
+            format!("Unknown property '{prop}' - a getter is not registered for type '{t0}'"),
+            pos,
+        )
+        .into()
+    }
+
+    /// The error of setter `setter` (`set$prop`) missing for type `t0` and value type `t1`.
+    #[cfg(not(feature = "no_object"))]
+    pub(crate) fn setter_not_found(
+        &self,
+        setter: &str,
+        t0: &str,
+        t1: &str,
+        pos: Position,
+    ) -> crate::RhaiError {
+        let prop = &setter[crate::engine::FN_SET.len()..];
+        let t0 = self.map_type_name(t0);
+        let t1 = self.map_type_name(t1);
+        ERR::ErrorDotExpr(
+            format!(
+                "No writable property '{prop}' - a setter is not registered for type '{t0}' to handle '{t1}'"
+            ),
+            pos,
+        )
+        .into()
     }
 
     /// # Main Entry-Point (By Name)

@@ -388,7 +388,11 @@ impl Engine {
             #[cfg(not(feature = "no_ast"))]
             ScriptFuncPayload::Statements(ref body) => {
                 // Put arguments into scope as variables
-                scope.extend(fn_def.params.iter().cloned().zip(arg_values));
+                // The names are shared, not copied: `Scope::extend` would allocate each anew
+                // (a critterbox patch, see `PATCH.md`).
+                for (name, value) in fn_def.params.iter().cloned().zip(arg_values) {
+                    scope.push_entry(name, crate::types::dynamic::AccessMode::ReadWrite, value);
+                }
                 _arg_slots = fn_def.params.len();
 
                 #[cfg(feature = "debugging")]
