@@ -46,7 +46,8 @@ fn measure<V: Vector>(w: &mut World<V>, collisions: usize) -> (usize, f64, f64, 
     let secs = start.elapsed().as_secs_f64();
     let t = w.totals();
     println!(
-        "  per collision: {:.2} events, {:.2} predictions, {:.1} pair tests",
+        "  {:.0} collisions per step; per collision: {:.2} events, {:.2} predictions, {:.1} pair tests",
+        impacts as f64 / ((w.time() - t0) / w.dt()).round(),
         t.events as f64 / t.impacts as f64,
         t.candidates as f64 / t.impacts as f64,
         t.pair_tests as f64 / t.impacts as f64
