@@ -90,12 +90,10 @@ fn against<V: Vector>(
     }
 }
 
-/// How many critters ahead [`end_flight`] asks for the critter and body it will read.
-const END_AHEAD: usize = 16;
-
 /// Brings every critter (and its body) to flight time `end` along its flight, and wraps or
 /// borders the disks into the box; then surveys them for the next step ([`EndSurvey`]), in the
 /// same pass: a step of a kept flight reads every critter once.
+#[allow(clippy::needless_range_loop)] // bodies, statuses and slots indexed together
 pub(super) fn end_flight<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, end: f64) {
     let topo = w.topo;
     let n = sc.body.len().min(w.critters.slot_count());
@@ -105,9 +103,6 @@ pub(super) fn end_flight<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, end: 
     let straight = sc.straight;
     let slots = &mut w.critters.slots_mut_moving()[..n];
     for a in 0..n {
-        // The stream of critters outruns the processor's own prefetching.
-        crate::prefetch::prefetch(slots.get(a + END_AHEAD));
-        crate::prefetch::prefetch(sc.body.get(a + END_AHEAD));
         let s = sc.status[a];
         // As `advance` (a line needs no acceleration, the most common case).
         let motion = match (s.alive && !s.wall, straight) {
