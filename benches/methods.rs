@@ -7,7 +7,8 @@
 //!
 //! `cargo bench --bench methods` runs criterion (throughput in collisions/s);
 //! `CRITTERBOX_REPORT=1 cargo bench --bench methods` prints the report instead
-//! (`CRITTERBOX_REPORT=2d` or `=3d` for one system).
+//! (`CRITTERBOX_REPORT=2d` or `=3d` for one system; `CRITTERBOX_DT=0.0166667` measures steps
+//! of that length instead of 5, after the same warm-up step of 5).
 
 use criterion::{Criterion, Throughput};
 use critterbox::glam::{DVec2, DVec3};
@@ -45,7 +46,8 @@ fn measure<V: Vector>(w: &mut World<V>, collisions: usize) -> (usize, f64, f64, 
     let secs = start.elapsed().as_secs_f64();
     let t = w.totals();
     println!(
-        "  per collision: {:.2} events, {:.2} predictions, {:.1} pair tests",
+        "  {:.0} collisions per step; per collision: {:.2} events, {:.2} predictions, {:.1} pair tests",
+        impacts as f64 / ((w.time() - t0) / w.dt()).round(),
         t.events as f64 / t.impacts as f64,
         t.candidates as f64 / t.impacts as f64,
         t.pair_tests as f64 / t.impacts as f64
@@ -69,6 +71,14 @@ fn report(which: &str) {
     }
 }
 
+/// The measured steps' length: 5, or `CRITTERBOX_DT` (a frame's 1/60 shows the per-step cost).
+fn measured_dt() -> f64 {
+    std::env::var("CRITTERBOX_DT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5.0)
+}
+
 /// Collisions to measure: 2e6, or `CRITTERBOX_COLLISIONS` (shorter runs for profilers).
 fn collisions() -> usize {
     std::env::var("CRITTERBOX_COLLISIONS")
@@ -80,9 +90,11 @@ fn collisions() -> usize {
 fn report_2d() {
     let mut g2 = periodic_gas::<DVec2>(10_000, 0.4, 5.0);
     g2.run(1).expect("warm up");
+    g2.set_dt(measured_dt()).expect("dt");
     let (c, s, drift, z) = measure(&mut g2, collisions());
     println!(
-        "2D 10,000 disks, phi 0.4, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4}",
+        "2D 10,000 disks, phi 0.4, periodic, dt {:.4}: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4}",
+        g2.dt(),
         c as f64 / s
     );
 }
@@ -90,9 +102,11 @@ fn report_2d() {
 fn report_3d() {
     let mut g3 = periodic_gas::<DVec3>(32_000, 0.4, 5.0);
     g3.run(1).expect("warm up");
+    g3.set_dt(measured_dt()).expect("dt");
     let (c, s, drift, z) = measure(&mut g3, collisions());
     println!(
-        "3D 32,000 spheres, phi 0.40, periodic: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4} (literature 6.91)",
+        "3D 32,000 spheres, phi 0.40, periodic, dt {:.4}: {c} collisions in {s:.2} s = {:.3e} /s; energy drift {drift:.2e}; Z = {z:.4} (literature 6.91)",
+        g3.dt(),
         c as f64 / s
     );
 }

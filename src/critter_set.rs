@@ -34,6 +34,9 @@ pub struct CritterSet<V: Vector> {
     place: Vec<u32>,
     live: usize,
     statics: Statics,
+    /// The mark of the last [`CritterSet::mark_untouched`], or 0 once a mutable accessor has
+    /// been called since (the engine's `*_moving` ones too).
+    untouched: u64,
     /// The traits of the critter added last, which the next one shares if it is alike (see
     /// [`Traits::same_plain`]): a gas spawned from one kind keeps one copy.
     shared: Option<Arc<Traits<V>>>,
@@ -90,6 +93,7 @@ impl<V: Vector> Default for CritterSet<V> {
             place: Vec::new(),
             live: 0,
             statics: Statics::default(),
+            untouched: 0,
             shared: None,
         }
     }
@@ -98,6 +102,7 @@ impl<V: Vector> Default for CritterSet<V> {
 impl<V: Vector> CritterSet<V> {
     /// Inserts the critter built by `make` for its new id. O(1) amortised.
     pub fn insert(&mut self, make: impl FnOnce(CritterId) -> Critter<V>) -> CritterId {
+        self.untouched = 0;
         self.statics.forget();
         let index = match self.free.pop() {
             Some(i) => i,
@@ -201,6 +206,7 @@ impl<V: Vector> CritterSet<V> {
     /// # Panics
     /// If `keys` is not one per slot, or there are 2^31 slots or more.
     pub(crate) fn arrange(&mut self, keys: &[u32]) {
+        self.untouched = 0;
         use rayon::prelude::*;
         const DONE: u32 = 1 << 31;
         let n = self.slots.len();
@@ -240,6 +246,7 @@ impl<V: Vector> CritterSet<V> {
 
     /// Puts every critter back in the slot its id's index names (undoes `CritterSet::arrange`).
     pub(crate) fn unarrange(&mut self) {
+        self.untouched = 0;
         if self.place.is_empty() {
             return;
         }
@@ -261,6 +268,7 @@ impl<V: Vector> CritterSet<V> {
 
     /// Removes critter `id`, if it is there. O(1).
     pub fn remove(&mut self, id: CritterId) -> Option<Critter<V>> {
+        self.untouched = 0;
         let i = id.index as usize;
         let slot = self.slot_of(id)? as usize;
         self.statics.forget();
@@ -307,6 +315,7 @@ impl<V: Vector> CritterSet<V> {
     /// only (anything else written through it would leave the next state hash stale).
     #[inline]
     pub(crate) fn slot_mut_moving(&mut self, index: u32) -> Option<&mut Critter<V>> {
+        self.untouched = 0;
         self.slots.get_mut(index as usize).and_then(Option::as_mut)
     }
 
@@ -323,6 +332,7 @@ impl<V: Vector> CritterSet<V> {
     /// [`CritterSet::pair_mut`] for the engine's writes of position and velocity only.
     #[inline]
     pub(crate) fn pair_mut_moving(&mut self, a: u32, b: u32) -> (&mut Critter<V>, &mut Critter<V>) {
+        self.untouched = 0;
         assert_ne!(a, b, "a critter cannot collide with itself");
         let (a, b) = (a as usize, b as usize);
         let (first, second) = if a < b {
@@ -366,6 +376,7 @@ impl<V: Vector> CritterSet<V> {
 
     /// The critters, in parallel (each is visited by one thread).
     pub fn par_iter_mut(&mut self) -> impl rayon::iter::ParallelIterator<Item = &mut Critter<V>> {
+        self.untouched = 0;
         self.statics.forget();
         use rayon::prelude::*;
         self.slots.par_iter_mut().filter_map(Option::as_mut)
@@ -378,7 +389,22 @@ impl<V: Vector> CritterSet<V> {
 
     /// Every slot, mutably, for the engine's writes of position and velocity only.
     pub(crate) fn slots_mut_moving(&mut self) -> &mut [Option<Critter<V>>] {
+        self.untouched = 0;
         &mut self.slots
+    }
+
+    /// Marks the critters as untouched from now on: the mark returned, unique to this call, is
+    /// what [`CritterSet::untouched_since`] compares (a clone keeps it, with the same critters).
+    pub(crate) fn mark_untouched(&mut self) -> u64 {
+        static MARKS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        self.untouched = MARKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.untouched
+    }
+
+    /// No mutable accessor was called since the [`CritterSet::mark_untouched`] that returned
+    /// `mark`.
+    pub(crate) fn untouched_since(&self, mark: u64) -> bool {
+        mark != 0 && self.untouched == mark
     }
 
     /// The hash lanes kept for the critters' rarely changing words.
@@ -418,6 +444,7 @@ impl<V: Vector> CritterSet<V> {
             place: Vec::new(),
             live: 0,
             statics: Statics::default(),
+            untouched: 0,
             shared: None,
         };
         for mut c in critters {
@@ -450,6 +477,7 @@ impl<V: Vector> CritterSet<V> {
     /// The critters in slot order, mutably, for the engine's writes of position, velocity and
     /// rule class only.
     pub(crate) fn iter_mut_moving(&mut self) -> impl Iterator<Item = &mut Critter<V>> {
+        self.untouched = 0;
         self.slots.iter_mut().filter_map(Option::as_mut)
     }
 }

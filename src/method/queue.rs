@@ -6,7 +6,7 @@
 //! entry per critter and has no stale entries to pop and skip. Events are ordered by time, then
 //! owner: each owner has one entry, so that order is total and a run repeats bit for bit.
 //!
-//! The flight's time span is cut into about one bucket per critter. Only the events of the
+//! The flight's time span (a kept flight's whole life) is cut into about one bucket per critter. Only the events of the
 //! buckets up to the current one are in the heap (a few, so a sift is a few levels); later ones
 //! wait in their bucket's list, where adding and removing costs a few pointer writes. A bucket
 //! follows from the time by a monotone formula, so every listed event is later than every event
@@ -56,8 +56,6 @@ pub(crate) struct Queue<E> {
     per_time: f64,
     /// The heap holds the events of the buckets up to this one.
     current: usize,
-    /// The pending events while `rebase` cuts the calendar anew (kept to save allocations).
-    spare: Vec<E>,
 }
 
 impl<E> Default for Queue<E> {
@@ -70,7 +68,6 @@ impl<E> Default for Queue<E> {
             start: 0.0,
             per_time: 0.0,
             current: 0,
-            spare: Vec::new(),
         }
     }
 }
@@ -94,6 +91,11 @@ impl<E: Owned> Queue<E> {
     /// Empties the queue for owners `0..n` and events between `start` and `end` (later events
     /// are kept too, in the last bucket).
     pub fn reset(&mut self, n: usize, start: f64, end: f64) {
+        self.reset_buckets(n, start, end, n.next_power_of_two());
+    }
+
+    /// [`Queue::reset`] with about `buckets` buckets (at least 64, at most 2^22).
+    pub fn reset_buckets(&mut self, n: usize, start: f64, end: f64, buckets: usize) {
         self.heap.keys.clear();
         self.links.clear();
         self.links.resize(n, UNLINKED);
@@ -101,7 +103,7 @@ impl<E: Owned> Queue<E> {
         self.events.resize_with(n, || None);
         let span = end - start;
         let buckets = if span > 0.0 && span.is_finite() && n > 0 {
-            n.next_power_of_two().clamp(64, 1 << 22)
+            buckets.next_power_of_two().clamp(64, 1 << 22)
         } else {
             0 // no span: everything in the heap
         };
@@ -114,21 +116,6 @@ impl<E: Owned> Queue<E> {
             0.0
         };
         self.current = 0;
-    }
-
-    /// Keeps every pending event, with the calendar cut anew for events between `start` and
-    /// `end` (a flight kept from one step to the next: the next step's span). The pops come in
-    /// the same order of (time, owner) as before.
-    pub fn rebase(&mut self, start: f64, end: f64) {
-        let n = self.links.len();
-        let mut pending = std::mem::take(&mut self.spare);
-        pending.clear();
-        pending.extend(self.events.iter().flatten().copied());
-        self.reset(n, start, end);
-        for &e in &pending {
-            self.set(e);
-        }
-        self.spare = pending;
     }
 
     #[cfg(test)]

@@ -2,10 +2,11 @@
 //! only the critters that something outside it changed between the steps (see the module docs
 //! of `flight`).
 
-use super::bodies::refresh_body;
+use super::bodies::{motion_at, refresh_body, Body, Status};
 use super::cells::relocate;
 use super::predict::predict;
 use super::{fly, fly_new, FlightEnd, Scratch};
+use crate::critter::Critter;
 use crate::error::Error;
 use crate::vector::Vector;
 use crate::world::state::State;
@@ -27,6 +28,130 @@ pub(super) struct KeptFlight {
     pub(super) step: u64,
     /// The step's length it was flown with.
     pub(super) dt: f64,
+}
+
+/// What the end of a flight found of the critters against their bodies, as [`take_up_kept`]
+/// would at the next step's start: while the critters are untouched since (`mark`), the next
+/// step takes it instead of comparing every critter again. The critters it found moved (the
+/// ones the end wrapped into the box) are in [`Scratch::changed`].
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct EndSurvey {
+    /// The critters' mark when the survey ended (see `CritterSet::mark_untouched`).
+    mark: u64,
+    /// Some critter's slot or shape does not match its body: the flight cannot go on.
+    lost: bool,
+    /// The live disks.
+    disks: usize,
+}
+
+/// Critter slot `slot` against its body and status, at flight time `start`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Against {
+    /// It came, went, or changed size, class or mobility, or it is a wall that moved.
+    Lost,
+    /// An empty slot, a dead critter or a wall, as the flight knows it.
+    NoDisk,
+    /// A live disk where its body is.
+    Same,
+    /// A live disk that something outside the flight moved or turned.
+    Moved,
+}
+
+#[inline]
+fn against<V: Vector>(
+    slot: &Option<Critter<V>>,
+    body: &Body<V>,
+    status: &Status,
+    start: f64,
+) -> Against {
+    let Some(c) = slot else {
+        return if status.alive {
+            Against::Lost
+        } else {
+            Against::NoDisk
+        };
+    };
+    let same = c.alive == status.alive
+        && c.is_wall() == status.wall
+        && (!c.alive
+            || if c.is_wall() {
+                c.pos == body.pos
+            } else {
+                c.radius == body.radius && c.class == status.class && c.fixed != status.free
+            });
+    if !same {
+        Against::Lost
+    } else if !c.alive || c.is_wall() {
+        Against::NoDisk
+    } else if c.pos != body.pos || c.vel != body.vel || body.t != start {
+        Against::Moved
+    } else {
+        Against::Same
+    }
+}
+
+/// Brings every critter (and its body) to flight time `end` along its flight, and wraps or
+/// borders the disks into the box; then surveys them for the next step ([`EndSurvey`]), in the
+/// same pass: a step of a kept flight reads every critter once.
+#[allow(clippy::needless_range_loop)] // bodies, statuses and slots indexed together
+pub(super) fn end_flight<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, end: f64) {
+    let topo = w.topo;
+    let n = sc.body.len().min(w.critters.slot_count());
+    let mut changed = std::mem::take(&mut sc.changed);
+    changed.clear();
+    let (mut lost, mut disks) = (false, 0usize);
+    let straight = sc.straight;
+    let slots = &mut w.critters.slots_mut_moving()[..n];
+    for a in 0..n {
+        let s = sc.status[a];
+        // As `advance` (a line needs no acceleration, the most common case).
+        let motion = match (s.alive && !s.wall, straight) {
+            (false, _) => None,
+            (true, true) => {
+                let b = &sc.body[a];
+                Some((b.pos + b.vel * (end - b.t), b.vel))
+            }
+            (true, false) => {
+                let m = motion_at(sc, a as u32, end);
+                Some((m.pos, m.vel))
+            }
+        };
+        let body = &mut sc.body[a];
+        if let Some((pos, vel)) = motion {
+            body.pos = pos;
+            body.vel = vel;
+            body.t = end;
+        }
+        let slot = &mut slots[a];
+        if let Some(c) = slot {
+            if let Some((pos, vel)) = motion {
+                c.pos = pos;
+                c.vel = vel;
+            }
+            if c.alive && !c.is_wall() {
+                c.pos = if topo.wraps() {
+                    topo.wrap_position(c.pos)
+                } else if topo.clear_of_edges(c.pos, c.radius) {
+                    c.pos // (what `apply` gives, without reading the restitution)
+                } else {
+                    topo.apply_at_edges(c.pos, c.vel, c.radius, c.restitution())
+                        .0
+                };
+            }
+        }
+        match against(slot, body, &s, end) {
+            Against::Lost => lost = true,
+            Against::NoDisk => {}
+            Against::Same => disks += 1,
+            Against::Moved => {
+                disks += 1;
+                changed.push(a as u32);
+            }
+        }
+    }
+    sc.changed = changed;
+    let mark = w.critters.mark_untouched();
+    sc.ended = EndSurvey { mark, lost, disks };
 }
 
 impl<V: Vector> Scratch<V> {
@@ -71,7 +196,7 @@ pub(super) fn fly_kept<V: Vector>(
     }
 }
 
-/// Takes up the flight kept from the last step, for a step of `span` from where it ended:
+/// Takes up the flight kept from the last step, from where it ended:
 /// every critter that something outside the flight changed since (its position or velocity is
 /// not its body's) is counted as changed (its partners' events with it go stale), put in its
 /// cell and predicted again, as after a collision (and the flight counted churned at `step`
@@ -81,7 +206,6 @@ pub(super) fn fly_kept<V: Vector>(
 pub(super) fn take_up_kept<V: Vector>(
     w: &mut State<V>,
     sc: &mut Scratch<V>,
-    span: f64,
     step: u64,
 ) -> Result<bool, Error> {
     let n = w.critters.slot_count();
@@ -90,45 +214,39 @@ pub(super) fn take_up_kept<V: Vector>(
     }
     let start = sc.ended_at;
     let mut changed = std::mem::take(&mut sc.changed);
-    changed.clear();
-    let mut disks = 0usize;
-    for (a, slot) in w.critters.slot_slice().iter().enumerate() {
-        let (body, status) = (&sc.body[a], &sc.status[a]);
-        let Some(c) = slot else {
-            if status.alive {
-                sc.changed = changed;
-                return Ok(false);
-            }
-            continue;
-        };
-        let same = c.alive == status.alive
-            && c.is_wall() == status.wall
-            && (!c.alive
-                || if c.is_wall() {
-                    c.pos == body.pos
-                } else {
-                    c.radius == body.radius && c.class == status.class && c.fixed != status.free
-                });
-        if !same {
+    let ended = sc.ended;
+    let disks = if w.critters.untouched_since(ended.mark) {
+        // Nothing touched the critters since the last flight's end surveyed them.
+        if ended.lost {
             sc.changed = changed;
             return Ok(false);
         }
-        if c.alive && !c.is_wall() {
-            disks += 1;
-            if c.pos != body.pos || c.vel != body.vel || body.t != start {
-                changed.push(a as u32);
+        ended.disks
+    } else {
+        changed.clear();
+        let mut disks = 0usize;
+        for (a, slot) in w.critters.slot_slice().iter().enumerate() {
+            match against(slot, &sc.body[a], &sc.status[a], start) {
+                Against::Lost => {
+                    sc.changed = changed;
+                    return Ok(false);
+                }
+                Against::NoDisk => {}
+                Against::Same => disks += 1,
+                Against::Moved => {
+                    disks += 1;
+                    changed.push(a as u32);
+                }
             }
         }
-    }
+        disks
+    };
     let churned = changed.len() as f64 > CHURN * disks as f64;
     sc.churned_at = churned.then_some(step);
     sc.stuck.clear();
     sc.virial = 0.0;
     sc.predictions = 0;
     sc.pair_tests = 0;
-    // The calendar over two steps: the events of this one never wait in its last bucket
-    // (`Queue::peek_until` leaves that, with everything after the next step, unopened).
-    sc.queue.rebase(start, start + 2.0 * span);
     for &a in &changed {
         sc.body[a as usize].t = start;
         let s = &mut sc.status[a as usize];

@@ -68,7 +68,7 @@ use bodies::{advance, refresh_body, Body, Status};
 use border::bounce_border;
 use cells::{cross_cell, relocate, StripedLists};
 use events::{prefetch_event, validity, Event, EventKind, Validity};
-use kept::{fly_kept, steps_to_live, take_up_kept, KeptFlight};
+use kept::{end_flight, fly_kept, steps_to_live, take_up_kept, EndSurvey, KeptFlight};
 use predict::{predict, predict_after_crossing};
 use setup::{mark_who_may_meet, setup};
 use shells::{relist, ShellCentre};
@@ -210,6 +210,8 @@ pub(crate) struct Scratch<V: Vector> {
     outgrown: bool,
     /// The critters changed between two steps of a kept flight (kept to save allocations).
     changed: Vec<u32>,
+    /// What the last flight's end found of the critters against their bodies.
+    ended: EndSurvey,
     /// The step at which the last event step that could have kept its flight could not, or had
     /// to predict more than [`CHURN`] of its critters again: something outside the flight
     /// changes critters every step (hooks steering them, spawns), and the kept flight does not
@@ -255,7 +257,7 @@ pub(crate) fn run<V: Vector>(
         .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
     let life = steps_to_live(keep, step);
     let out = match kept {
-        Some(_) => match take_up_kept(w, sc, t_end, step) {
+        Some(_) => match take_up_kept(w, sc, step) {
             Ok(true) => fly_kept(w, sc, acc, t_end, stats),
             Ok(false) => {
                 sc.churned_at = Some(step);
@@ -394,7 +396,7 @@ fn fly<V: Vector>(
             } else {
                 span
             };
-            setup(w, sc, acc, span, horizon);
+            setup(w, sc, acc, horizon, life);
             match sc.slow_below {
                 Some(limit) => {
                     mark_who_may_meet(w, sc);
@@ -541,19 +543,7 @@ fn fly<V: Vector>(
     // Everyone to the end of the flight.
     let end = grown.or(stopped).unwrap_or(t_end);
     sc.ended_at = end;
-    let topo = w.topo;
-    for a in 0..n {
-        advance(w, sc, a, end);
-        if let Some(c) = w.critters.slot_mut_moving(a) {
-            if c.alive && !c.is_wall() {
-                c.pos = if topo.wraps() {
-                    topo.wrap_position(c.pos)
-                } else {
-                    topo.apply(c.pos, c.vel, c.radius, c.restitution()).0
-                };
-            }
-        }
-    }
+    end_flight(w, sc, end);
     Ok(match grown {
         Some(t) => FlightEnd::Grown(t - start),
         None => FlightEnd::Done(stopped.map(|t| t - start)),

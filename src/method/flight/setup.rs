@@ -15,19 +15,30 @@ use crate::critter::{Shape, CLASS_UNSET};
 use crate::vector::Vector;
 use crate::world::state::State;
 
-/// Sets up a new flight for a step of `span`, its predictions looking to `horizon`.
+/// Sets up a new flight of `life` steps whose predictions look to `horizon`.
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 pub(super) fn setup<V: Vector>(
     w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
-    span: f64,
     horizon: f64,
+    life: u64,
 ) {
     let n = w.critters.slot_count();
-    // A kept flight's calendar covers two steps (see `take_up_kept`).
-    sc.queue
-        .reset(n, 0.0, if horizon > span { 2.0 * span } else { span });
+    if life > 1 {
+        // A kept flight's calendar covers its whole life (its later steps go on in it), with a
+        // bucket per event of the last step, at most one per two critters a step: more
+        // buckets would mostly be opened empty, fewer would fill the heap.
+        let most = (n / 2).max(64);
+        let per_step = match sc.processed {
+            0 => most,
+            events => (events as usize).min(most),
+        };
+        sc.queue
+            .reset_buckets(n, 0.0, horizon, per_step.saturating_mul(life as usize));
+    } else {
+        sc.queue.reset(n, 0.0, horizon);
+    }
     sc.stuck.clear();
     for v in [&mut sc.cell, &mut sc.last_partner] {
         v.clear();
