@@ -31,6 +31,7 @@
 
 use crate::border::Topology;
 use crate::critter::Critter;
+use crate::critter_set::CritterSet;
 use crate::vector::Vector;
 
 /// A critter slower than this many steps of gravity (`|g| dt`) at the end of a step is quiet.
@@ -66,6 +67,9 @@ pub(crate) struct Sleep<V> {
     sleepers: usize,
     /// Whether the last [`Sleep::check`] found every critter a live wall or a sleeper.
     all_still: bool,
+    /// The critters' mark when that check found them all still (0 otherwise): while they are
+    /// untouched since, the next check has nothing to look at.
+    still_mark: u64,
     /// Whether critters were removed since [`Sleep::take_removed`] last asked.
     removed: bool,
     /// Slots a `collide` hook took this step.
@@ -221,9 +225,23 @@ impl<V: Vector> Sleep<V> {
     }
 
     /// At the start of a step, after the update hooks: wakes the sleepers something moved (and
-    /// their islands), and fits the arrays to the slots.
-    pub(crate) fn check(&mut self, slots: &[Option<Critter<V>>]) {
+    /// their islands), and fits the arrays to the slots. With `reuse`, a check that found
+    /// everyone still stands while no one has touched the critters since.
+    pub(crate) fn check(&mut self, critters: &mut CritterSet<V>, reuse: bool) {
         self.stirred.clear();
+        let untouched = critters.untouched_since(self.still_mark);
+        if reuse && self.all_still && untouched && self.waking.is_empty() {
+            return;
+        }
+        self.look(critters.slot_slice());
+        self.still_mark = match self.all_still {
+            true => critters.mark_untouched(),
+            false => 0,
+        };
+    }
+
+    /// [`Sleep::check`]'s look at every critter.
+    fn look(&mut self, slots: &[Option<Critter<V>>]) {
         self.all_still = false;
         if self.quiet.len() != slots.len() {
             self.fit(slots);

@@ -40,8 +40,9 @@ pub(crate) struct MethodState<V: Vector> {
     sleep: Sleep<V>,
     /// The run was told once that a discrete step moved a critter farther than its radius.
     warned_tunnel: bool,
-    /// Steps in which every critter sleeps or is a wall are skipped (tests turn it off to
-    /// compare with the full step).
+    /// Steps in which every critter sleeps or is a wall are skipped, and so is their check of
+    /// the sleepers while no one touches the critters (tests turn it off to compare with the
+    /// full step).
     rest_shortcut: bool,
 }
 
@@ -200,7 +201,7 @@ impl<V: Vector> MethodState<V> {
         // Sleepers the update hooks moved wake now, as the step would wake them, so that the
         // partition takes only true sleepers as still.
         if self.sleep.count() > 0 {
-            self.sleep.check(state.critters.slot_slice());
+            self.sleep.check(&mut state.critters, self.rest_shortcut);
         }
         if self.sleep.count() > 0 && self.all_asleep(state) {
             // Nothing to cut, and no partition to pay for.
@@ -322,7 +323,7 @@ impl<V: Vector> MethodState<V> {
         }
         self.sleep.active = solving && !self.sleep.off && state.gravity != V::zero();
         if self.sleep.active {
-            self.sleep.check(state.critters.slot_slice());
+            self.sleep.check(&mut state.critters, self.rest_shortcut);
         } else {
             self.sleep.clear();
         }
