@@ -258,7 +258,7 @@ pub fn run(args: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Result<(), Box<
                     None => format!("> {:.0}", (settle_steps + rest_steps) as f64 * DT),
                 };
                 println!(
-                    "| {n} | {threads} | {} | {settle_steps} | {settling} | {slept} | {:.3} | {overlap:.4} | {ke:.1e} | {} | {out} |",
+                    "| {n} | {threads} | {} | {settle_steps} | {settling} | {slept} | {:.4} | {overlap:.4} | {ke:.1e} | {} | {out} |",
                     e.name(),
                     median(times),
                     e.asleep()?,
