@@ -387,14 +387,14 @@ pub(crate) fn respond<V: Vector>(
     // Pairs of sleepers (or of a sleeper and a wall) had no row: their impulses are kept
     // as they were, for when the island wakes.
     let still = sleep.still();
-    let both_still = |&&(key, _): &&(u64, f64)| {
-        let (lo, hi) = unpair_key(key);
-        let still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
-        still(lo) && still(hi)
-    };
     let asleep: Vec<(u64, f64)> = match still.is_empty() {
         true => Vec::new(),
-        false => s.warm.iter().filter(both_still).copied().collect(),
+        false => s
+            .warm
+            .iter()
+            .filter(|w| both_still(still, w.0))
+            .copied()
+            .collect(),
     };
     s.warm.clear();
     let split = s
@@ -444,11 +444,14 @@ pub(crate) fn rest<V: Vector>(s: &mut Scratch<V>, sleep: &Sleep<V>, removed: boo
         return;
     }
     let still = sleep.still();
+    s.warm.retain(|w| both_still(still, w.0));
+}
+
+/// True when both critters of the pair `key` are still (`still` by slot: sleepers and walls).
+fn both_still(still: &[bool], key: u64) -> bool {
+    let (lo, hi) = unpair_key(key);
     let is_still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
-    s.warm.retain(|&(key, _)| {
-        let (lo, hi) = unpair_key(key);
-        is_still(lo) && is_still(hi)
-    });
+    is_still(lo) && is_still(hi)
 }
 
 /// Calls `caller`'s own `collide` on the pair (counted in `handled` when it touched), or
