@@ -3,6 +3,7 @@
 
 mod script_common;
 
+use critterbox::PropValue;
 use script_common::*;
 
 #[test]
@@ -74,4 +75,69 @@ fn property_of_a_type_with_no_indexer_names_the_missing_getter_or_setter() {
         let e = script_error(e);
         assert!(e.to_string().contains(want), "`{line}`: {e}");
     }
+}
+
+/// A kind's hooks of the same arity (`update(me, dt)`, `collide(me, other)`) share the kind's
+/// kept resolutions, and each call still runs its own function.
+#[test]
+fn hooks_of_one_arity_each_run_their_own_function() {
+    let sandbox = Sandbox::new("hook_calls_same_arity");
+    sandbox.kind(
+        "counter",
+        r#"
+defaults(#{ props: #{ ups: 0, hits: 0 } });
+fn update(me, dt) { me.ups += 1; }
+fn collide(me, other) { me.hits += 1; me.collide_default(other); }
+"#,
+    );
+    let mut scene = sandbox.load(
+        r#"
+let w = world(#{ dim: 2, size: vec(40, 10), seed: 1 });
+spawn("counter", #{ pos: vec(10, 5), vel: vec(6, 0), props: #{ tag: "a" } });
+spawn("counter", #{ pos: vec(30, 5), vel: vec(-6, 0), props: #{ tag: "b" } });
+"#,
+    );
+    let steps = 180;
+    for _ in 0..steps {
+        assert_eq!(step(&mut scene), None);
+    }
+    let w = w2(&scene);
+    let mut hits = 0;
+    for tag in ["a", "b"] {
+        let c = tagged(w, tag);
+        assert_eq!(prop_int(w, c, "ups"), steps, "update calls of {tag}");
+        hits += prop_int(w, c, "hits");
+    }
+    // A pair's `collide` is called for one of the two.
+    assert!((1..steps).contains(&hits), "collide ran {hits} times");
+}
+
+/// Writing a property the value it already holds changes nothing; a value that compares equal
+/// but differs in its bits (`-0.0` over `0.0`) is still written.
+#[test]
+fn a_property_written_with_equal_but_different_bits_takes_them() {
+    let sandbox = Sandbox::new("hook_calls_same_bits");
+    sandbox.kind(
+        "writer",
+        r#"
+defaults(#{ props: #{ z: 0.0, n: 3, again: 0.0 } });
+fn update(me, dt) { me.z = -0.0; me.n = 3; me.again = 0.0; }
+"#,
+    );
+    let mut scene = sandbox.load(
+        r#"
+let w = world(#{ dim: 2, size: vec(20, 10), seed: 1 });
+spawn("writer", #{ pos: vec(5, 5), fixed: true, props: #{ tag: "w" } });
+"#,
+    );
+    assert_eq!(step(&mut scene), None);
+    let w = w2(&scene);
+    let c = tagged(w, "w");
+    let bits = |name: &str| match prop(w, c, name) {
+        PropValue::Float(x) => x.to_bits(),
+        other => panic!("{name} should be a number, is {other:?}"),
+    };
+    assert_eq!(bits("z"), (-0.0f64).to_bits());
+    assert_eq!(bits("again"), 0.0f64.to_bits());
+    assert_eq!(prop_int(w, c, "n"), 3);
 }

@@ -4,7 +4,7 @@
 
 use super::values::{from_prop, from_svec, num_or, to_prop, to_svec};
 use super::{error, fail, fail_hint, lib_err, Res};
-use crate::critter::CritterId;
+use crate::critter::{CritterId, PropValue};
 use crate::script::host::{with_env, Host};
 use crate::vector::Vector;
 use crate::world::check_radius_in_box;
@@ -64,7 +64,11 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
             };
         };
         // An update hook sets properties of every critter every step: no allocation when the
-        // property exists.
+        // property exists, and no change (nor a copy of shared traits) when it already holds
+        // the same bits.
+        if c.props().get(name).is_some_and(|p| same_bits(p, &prop)) {
+            return Ok(());
+        }
         if let Some(slot) = c.props_mut().get_mut(name) {
             *slot = prop;
             return Ok(());
@@ -86,6 +90,21 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
             ),
         )
     })
+}
+
+/// True when `a` and `b` are the same scalar, bit for bit (so `-0.0` differs from `0.0`);
+/// false for text, lists and maps, which are simply written.
+fn same_bits(a: &PropValue, b: &PropValue) -> bool {
+    match (a, b) {
+        (PropValue::Bool(a), PropValue::Bool(b)) => a == b,
+        (PropValue::Int(a), PropValue::Int(b)) => a == b,
+        (PropValue::Float(a), PropValue::Float(b)) => a.to_bits() == b.to_bits(),
+        (PropValue::Critter(a), PropValue::Critter(b)) => a == b,
+        (PropValue::Vector(a), PropValue::Vector(b)) => {
+            a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())
+        }
+        _ => false,
+    }
 }
 
 fn set_vec<V: Vector>(slot: &mut V, v: DVec3, what: &str) -> Res<()> {
