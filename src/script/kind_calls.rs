@@ -32,8 +32,8 @@ pub(crate) struct HookFrame {
     pub hook: &'static str,
     pub me: CritterId,
     pub other: Option<CritterId>,
-    /// The contact `collide` was given, if it took one.
-    pub contact: Option<ScriptContact>,
+    /// The contact `collide` was given, if it took one (boxed: every hook call pushes a frame).
+    pub contact: Option<Box<ScriptContact>>,
     /// True on the first step of the pair's touching spell (`collide` only).
     pub first: bool,
     /// The impulse of the last `me.collide_default(other)` in this call (`collide` only).
@@ -45,7 +45,10 @@ struct Popped<'h>(&'h Host);
 
 impl Drop for Popped<'_> {
     fn drop(&mut self) {
-        self.0.frames.borrow_mut().pop();
+        // Dropped in place: `pop` would move the frame out first.
+        let mut frames = self.0.frames.borrow_mut();
+        let top = frames.len().saturating_sub(1);
+        frames.truncate(top);
     }
 }
 
@@ -173,7 +176,7 @@ impl ScriptKind {
             let cell = Rc::new(Cell::new(0.0));
             frame.impulse = Some(cell.clone());
             let contact = contact.with_impulse(cell);
-            frame.contact = Some(contact.clone());
+            frame.contact = Some(Box::new(contact.clone()));
             self.call(
                 "collide",
                 f,
@@ -391,7 +394,7 @@ pub(crate) fn parent_collide(
         }
         return Ok(impulse.is_some());
     };
-    let contact = match contact.or(frame.contact) {
+    let contact = match contact.or(frame.contact.map(|c| *c)) {
         Some(c) => c,
         None if f.params == 3 => {
             with_env!(host, env => ScriptContact::between(env, me, other, frame.first))?
@@ -405,7 +408,7 @@ pub(crate) fn parent_collide(
     let got = if f.params == 3 {
         let cell = inner.impulse.get_or_insert_with(|| Rc::new(Cell::new(0.0)));
         let contact = contact.with_impulse(cell.clone());
-        inner.contact = Some(contact.clone());
+        inner.contact = Some(Box::new(contact.clone()));
         kind.call(
             "collide",
             &f,
