@@ -154,6 +154,22 @@ impl Engine {
         global: &mut GlobalRuntimeState,
         caches: &mut Caches,
     ) -> RhaiResult {
+        self._call_fn_found(options, scope, ast, name, arg_values, global, caches, None)
+    }
+    /// [`Engine::_call_fn`], given the script function `name` of `ast` when the caller has
+    /// found it already (a critterbox patch, see `PATCH.md`).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn _call_fn_found(
+        &self,
+        options: CallFnOptions,
+        scope: &mut Scope,
+        ast: &AST,
+        name: &str,
+        arg_values: &mut [Dynamic],
+        global: &mut GlobalRuntimeState,
+        caches: &mut Caches,
+        found: Option<&crate::func::ScriptFuncDef>,
+    ) -> RhaiResult {
         let statements = ast.statements();
 
         let orig_source = mem::replace(&mut global.source, ast.source_raw().cloned());
@@ -201,7 +217,12 @@ impl Engine {
             #[cfg(not(feature = "unchecked"))]
             crate::func::ensure_no_data_race(name, args, false)?;
 
-            if let Some(fn_def) = ast.shared_lib().get_script_fn(name, args.len()) {
+            let found = found.or_else(|| {
+                ast.shared_lib()
+                    .get_script_fn(name, args.len())
+                    .map(|f| &**f)
+            });
+            if let Some(fn_def) = found {
                 self.call_script_fn(
                     global.into(),
                     caches,

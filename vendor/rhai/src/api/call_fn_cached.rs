@@ -11,8 +11,8 @@ use crate::eval::Caches;
 use crate::func::ScriptFuncDef;
 use crate::types::dynamic::Variant;
 use crate::{
-    CallFnOptions, Dynamic, Engine, FnArgsVec, FuncArgs, Position, RhaiResult, RhaiResultOf,
-    Scope, Shared, SharedModule, AST, ERR,
+    CallFnOptions, Engine, FnArgsVec, FuncArgs, Position, RhaiResultOf, Scope, Shared,
+    SharedModule, AST, ERR,
 };
 #[cfg(feature = "no_std")]
 use std::prelude::v1::*;
@@ -58,34 +58,17 @@ impl Engine {
         args.parse(&mut arg_values);
 
         let name = fn_name.as_ref();
-        let lean = !options.eval_ast && options.this_ptr.is_none();
-        #[cfg(feature = "debugging")]
-        let lean = lean && !self.is_debugger_registered();
-        let fn_def = if lean {
-            cache.script_fn(ast, name, arg_values.len())
-        } else {
-            None
-        };
-        let result = match fn_def {
-            Some(fn_def) => self.call_script_fn_lean(
-                options,
-                scope,
-                ast,
-                name,
-                &fn_def,
-                arg_values.as_mut(),
-                &mut cache.caches,
-            ),
-            None => self._call_fn(
-                options,
-                scope,
-                ast,
-                name,
-                arg_values.as_mut(),
-                &mut self.new_global_runtime_state(),
-                &mut cache.caches,
-            ),
-        };
+        let found = cache.script_fn(ast, name, arg_values.len());
+        let result = self._call_fn_found(
+            options,
+            scope,
+            ast,
+            name,
+            arg_values.as_mut(),
+            &mut self.new_global_runtime_state(),
+            &mut cache.caches,
+            found.as_deref(),
+        );
         // Only the call's own level is kept: an inner one belongs to what pushed it.
         cache.caches.rewind_fn_resolution_caches(1);
 
@@ -99,57 +82,6 @@ impl Engine {
                 ERR::ErrorMismatchOutputType(cast_type.into(), result_type.into(), Position::NONE)
                     .into()
             })
-        })
-    }
-
-    /// What [`Engine::_call_fn`] does for a script function `fn_def` of `ast` with no statements
-    /// to evaluate first, no `this` and no debugger, without restoring a runtime state that is
-    /// dropped right after.
-    #[allow(clippy::too_many_arguments)]
-    fn call_script_fn_lean(
-        &self,
-        options: CallFnOptions,
-        scope: &mut Scope,
-        ast: &AST,
-        name: &str,
-        fn_def: &ScriptFuncDef,
-        arg_values: &mut [Dynamic],
-        caches: &mut Caches,
-    ) -> RhaiResult {
-        let global = &mut self.new_global_runtime_state();
-        global.source = ast.source_raw().cloned();
-        global.lib.push(ast.shared_lib().clone());
-        if let Some(tag) = options.tag {
-            global.tag = tag;
-        }
-        #[cfg(not(feature = "no_module"))]
-        {
-            global.embedded_module_resolver = ast.resolver.clone();
-        }
-        let args = &mut arg_values.iter_mut().collect::<FnArgsVec<_>>();
-        let result = (|| {
-            #[cfg(not(feature = "no_closure"))]
-            #[cfg(not(feature = "unchecked"))]
-            crate::func::ensure_no_data_race(name, args, false)?;
-            self.call_script_fn(
-                global.into(),
-                caches,
-                scope,
-                None,
-                None,
-                fn_def,
-                args,
-                options.rewind_scope,
-                Position::NONE,
-            )
-            .or_else(|err| match *err {
-                ERR::Exit(out, ..) => Ok(out),
-                _ => Err(err),
-            })
-        })();
-        result.map_err(|err| match *err {
-            ERR::ErrorInFunctionCall(fn_name, _, inner_err, _) if fn_name == name => inner_err,
-            _ => err,
         })
     }
 }
