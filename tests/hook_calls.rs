@@ -1,5 +1,6 @@
-//! A kind's hooks keep what their calls resolved function names to from one call to the next
-//! (`call_fn_cached`): the answers must be the kind's own, also for a hook it inherits.
+//! A kind's hooks run as bytecode on a virtual machine kept from one call to the next
+//! (`Vm::call_fn_kept`), or on the AST with its resolutions kept (`call_fn_cached`): what the
+//! calls find must be the kind's own, also for a hook it inherits, and read as the AST would.
 
 mod script_common;
 
@@ -140,4 +141,109 @@ spawn("writer", #{ pos: vec(5, 5), fixed: true, props: #{ tag: "w" } });
     assert_eq!(bits("z"), (-0.0f64).to_bits());
     assert_eq!(bits("again"), 0.0f64.to_bits());
     assert_eq!(prop_int(w, c, "n"), 3);
+}
+
+/// In a hook (run as bytecode), a property no getter, setter or indexer answers is reported as
+/// the getter or setter that is missing, as it is in a scene's script.
+#[test]
+fn a_missing_property_in_a_hook_names_the_missing_getter_or_setter() {
+    let sandbox = Sandbox::new("hook_calls_missing_property_in_hook");
+    let cases = [
+        (
+            "v.foo = 3;",
+            "No writable property 'foo' - a setter is not registered for type 'Vec' to handle 'i64'",
+        ),
+        (
+            "let a = v.foo;",
+            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
+        ),
+        (
+            "v.foo += 1;",
+            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
+        ),
+    ];
+    for (i, (line, want)) in cases.into_iter().enumerate() {
+        let kind = format!("prober{i}");
+        sandbox.kind(
+            &kind,
+            &format!("fn update(me, dt) {{\n    let v = vec(1.0, 2.0);\n    {line}\n}}\n"),
+        );
+        let mut scene = sandbox.load(&format!(
+            "let w = world(#{{ dim: 2, size: vec(20, 10), seed: 1 }});\nspawn(\"{kind}\", #{{ pos: vec(5, 5) }});\n"
+        ));
+        let e = scene
+            .step()
+            .expect_err("the hook fails the step")
+            .to_string();
+        assert!(e.contains(want), "`{line}`: {e}");
+        assert!(
+            e.contains(&format!("{kind}.rhai:3")),
+            "`{line}`: no line: {e}"
+        );
+    }
+}
+
+/// A hook that hands closures and function pointers to native functions (`map`, `reduce`,
+/// `call`) runs them: such a kind's hooks run on the AST, where the natives find them.
+#[test]
+fn hooks_that_hand_closures_to_natives_run_them() {
+    let sandbox = Sandbox::new("hook_calls_closures");
+    sandbox.kind(
+        "folder",
+        r#"
+defaults(#{ props: #{ sum: 0 } });
+fn double(x) { x * 2 }
+fn update(me, dt) {
+    let doubled = [1, 2, 3].map(|x| x * 2);
+    me.sum = doubled.reduce(|s, x| s + x, 0) + Fn("double").call(10);
+}
+"#,
+    );
+    let mut scene = sandbox.load(
+        r#"
+let w = world(#{ dim: 2, size: vec(20, 10), seed: 1 });
+spawn("folder", #{ pos: vec(5, 5), fixed: true, props: #{ tag: "f" } });
+"#,
+    );
+    assert_eq!(step(&mut scene), None);
+    let w = w2(&scene);
+    assert_eq!(prop_int(w, tagged(w, "f"), "sum"), 2 + 4 + 6 + 20);
+}
+
+/// A hook's parameters are in its scope by name, and a function it calls sees its own
+/// parameters and not the hook's, on every call of the hook.
+#[test]
+fn a_hook_and_the_functions_it_calls_see_their_own_parameters() {
+    let sandbox = Sandbox::new("hook_calls_parameters");
+    sandbox.kind(
+        "namer",
+        r#"
+defaults(#{ props: #{ hook_sees: 0, helper_sees: 0, diff: 0 } });
+fn helper(a, b) {
+    if is_def_var("a") && is_def_var("b") && !is_def_var("dt") { a - b } else { -1000 }
+}
+fn update(me, dt) {
+    if is_def_var("me") && is_def_var("dt") && !is_def_var("a") { me.hook_sees += 1; }
+    me.diff = helper(5, 3);
+    if me.diff == 2 { me.helper_sees += 1; }
+}
+"#,
+    );
+    let mut scene = sandbox.load(
+        r#"
+let w = world(#{ dim: 2, size: vec(20, 10), seed: 1 });
+spawn("namer", #{ pos: vec(5, 5), fixed: true, props: #{ tag: "n" } });
+spawn("namer", #{ pos: vec(15, 5), fixed: true, props: #{ tag: "m" } });
+"#,
+    );
+    let steps = 3;
+    for _ in 0..steps {
+        assert_eq!(step(&mut scene), None);
+    }
+    let w = w2(&scene);
+    for tag in ["n", "m"] {
+        let c = tagged(w, tag);
+        assert_eq!(prop_int(w, c, "hook_sees"), steps, "{tag}");
+        assert_eq!(prop_int(w, c, "helper_sees"), steps, "{tag}");
+    }
 }

@@ -16,6 +16,7 @@ use super::{read_script, Runtime, SourceFile};
 use crate::error::{Error, ScriptError};
 use crate::kind::{KindDefaults, KindId};
 use crate::world::World;
+use rhai::grain::{Compiler, Program, VmKeep};
 use rhai::{FnCallCache, Map, Position, Scope, AST};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -94,6 +95,10 @@ pub(crate) struct ScriptKindDef {
     /// What the calls of its hooks resolved function names to, kept for the next calls: they
     /// all run in `ast` with the one engine, so the answers stay right.
     pub(super) calls: RefCell<FnCallCache>,
+    /// `ast` compiled to rhai's bytecode (Grain), which runs the hooks; its virtual machine's
+    /// state is kept from one call to the next in `vm`.
+    pub(super) program: Program<'static>,
+    pub(super) vm: RefCell<VmKeep>,
 }
 
 impl ScriptKindDef {
@@ -276,6 +281,7 @@ pub(crate) fn build(
         Some(p) => p.ast.merge(&own),
         None => own,
     });
+    let program = Compiler::new().compile(&ast);
     let def = Rc::new_cyclic(|me: &Weak<ScriptKindDef>| {
         let mut hooks: [Option<Rc<HookFn>>; HOOKS.len()] = Default::default();
         for (i, (hook, _)) in HOOKS.iter().enumerate() {
@@ -301,6 +307,8 @@ pub(crate) fn build(
             hooks,
             parent_def: parent.clone(),
             calls: RefCell::new(FnCallCache::default()),
+            program,
+            vm: RefCell::new(VmKeep::default()),
         }
     });
     Ok(def)

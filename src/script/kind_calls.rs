@@ -16,6 +16,7 @@ use crate::kind::{CollideRule, KindHooks, KindId, KindSet, RuleCtx};
 use crate::rng::Rng;
 use crate::vector::Vector;
 use crate::world::World;
+use rhai::grain::Vm;
 use rhai::{CallFnOptions, Dynamic, Scope, INT};
 use std::cell::Cell;
 use std::rc::Rc;
@@ -75,9 +76,27 @@ impl ScriptKind {
         let engine = &self.rt.engine;
         let (scope, calls) = (f.scope.try_borrow_mut(), self.def.calls.try_borrow_mut());
         let result = profiler.time(&self.def.name, hook, || match (scope, calls) {
-            (Ok(mut scope), Ok(mut calls)) => {
-                engine.call_fn_cached(&mut calls, options, &mut scope, &self.def.ast, hook, args)
-            }
+            // The kind's bytecode, unless it makes function pointers: a native function calling
+            // one back (`map`, `filter`) finds only the AST's functions.
+            (Ok(mut scope), Ok(mut calls)) => match self.def.vm.try_borrow_mut() {
+                Ok(mut keep) if !self.def.program.makes_fn_pointers() => Vm::call_fn_kept(
+                    engine,
+                    &mut keep,
+                    options,
+                    &mut scope,
+                    &self.def.program,
+                    hook,
+                    args,
+                ),
+                _ => engine.call_fn_cached(
+                    &mut calls,
+                    options,
+                    &mut scope,
+                    &self.def.ast,
+                    hook,
+                    args,
+                ),
+            },
             // A hook re-entered (a spawn's init inside another hook): a fresh scope and cache.
             _ => engine.call_fn_with_options(options, &mut Scope::new(), &self.def.ast, hook, args),
         });

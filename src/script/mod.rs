@@ -3,11 +3,12 @@
 //! `init`. The user's guide is `docs/scripting.md`.
 //!
 //! One `Runtime` per run holds the engine (built once by `api::build_engine`), each kind's
-//! compiled AST, and the `Host` (`host.rs`) through which running scripts reach the world. Each
-//! hook is a `call_fn` on an AST compiled once, with the top level not re-run, no per-call scope
-//! allocation, and the functions it calls resolved once per kind (`call_fn_cached`, a patch of
-//! the vendored rhai); a kind's hooks run only for pairs that really touch, and only for kinds
-//! that define them. A layer above (the script test runner, [`crate::testing`]) adds its
+//! compiled AST and its bytecode, and the `Host` (`host.rs`) through which running scripts reach
+//! the world. Each hook runs on a bytecode virtual machine kept per kind (`Vm::call_fn_kept`, a
+//! patch of the vendored rhai), with the top level not re-run, no per-call scope allocation, and
+//! the functions it calls resolved once per kind; a kind that hands closures to natives runs on
+//! its AST (`call_fn_cached`). A kind's hooks run only for pairs that really touch, and only for
+//! kinds that define them. A layer above (the script test runner, [`crate::testing`]) adds its
 //! functions through an `Extension`; nothing here depends on it or on recordings.
 
 pub(crate) mod api;

@@ -204,7 +204,7 @@ pub use compile::Compiler;
 pub use format::{Abi, AbiMismatch, Caps, ReadError, Sidecar, Stripped, WriteError};
 pub use pos::Site;
 pub use program::{Program, SharedProgram};
-pub use vm::{Fault, Vm};
+pub use vm::{Fault, Vm, VmKeep};
 
 #[cfg(feature = "internals")]
 pub use program::Function;

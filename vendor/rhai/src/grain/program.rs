@@ -141,6 +141,10 @@ pub struct Program<'a> {
     /// blob and the spans — and neither grows with how many names there are.
     names: Strings<'a>,
 
+    /// Each name's hash as a getter (one argument) and as a setter (two), computed once: a
+    /// property access would hash its accessor's name on every call (a critterbox patch).
+    accessor_hashes: Vec<[u64; 2]>,
+
     /// Operator tokens the built-in lookup keys on. A `Token` does not fit an
     /// operand, and one script uses a handful of distinct operators however
     /// many times it mentions them.
@@ -299,6 +303,7 @@ impl<'a> Program<'a> {
             residuals: parts.residuals,
             consts: parts.consts,
             names: parts.names,
+            accessor_hashes: Vec::new(),
             tokens: parts.tokens,
             assign_ops: parts.assign_ops,
             chains: parts.chains,
@@ -310,6 +315,7 @@ impl<'a> Program<'a> {
             source: parts.source,
         };
         program.recompute_max_stack();
+        program.accessor_hashes = accessor_hashes(&program.names);
         program
     }
 
@@ -330,6 +336,7 @@ impl<'a> Program<'a> {
             residuals: self.residuals,
             consts: self.consts,
             names: self.names.into_owned(),
+            accessor_hashes: self.accessor_hashes,
             tokens: self.tokens,
             assign_ops: self.assign_ops,
             chains: self.chains,
@@ -572,6 +579,12 @@ impl<'a> Program<'a> {
     /// A name, borrowed from the artifact. Never allocates.
     pub(crate) fn name(&self, index: u32) -> Option<&str> {
         self.names.get(index)
+    }
+
+    /// The hash of name `index` called as a getter (`argc` 1) or a setter (`argc` 2).
+    pub(crate) fn accessor_hash(&self, index: u32, argc: usize) -> Option<u64> {
+        let hashes = self.accessor_hashes.get(index as usize)?;
+        hashes.get(argc.checked_sub(1)?).copied()
     }
 
     pub(crate) fn token(&self, index: u32) -> Option<&Token> {
@@ -964,4 +977,17 @@ mod tests {
         assert_eq!(typed, vec![Some(1), None]);
         assert_eq!(reloaded.method(0, 0, "i64").unwrap().this_type, Some(1));
     }
+}
+
+/// Every name's hash as a function of one argument and of two.
+fn accessor_hashes(names: &Strings<'_>) -> Vec<[u64; 2]> {
+    names
+        .iter()
+        .map(|name| {
+            [
+                crate::calc_fn_hash(None, name, 1),
+                crate::calc_fn_hash(None, name, 2),
+            ]
+        })
+        .collect()
 }

@@ -19,7 +19,8 @@ use std::prelude::v1::*;
 /// actually has.
 #[derive(Debug, Clone, Default)]
 pub struct Strings<'a> {
-    blob: Cow<'a, [u8]>,
+    /// Valid UTF-8 as a whole (checked once), so a name is sliced out without another check.
+    blob: Cow<'a, str>,
     /// Start of each name; the end is the next start, so this is one longer
     /// than the number of names.
     starts: Vec<u32>,
@@ -29,11 +30,11 @@ impl<'a> Strings<'a> {
     /// Build from names in index order.
     #[must_use]
     pub fn new<S: AsRef<str>>(names: impl IntoIterator<Item = S>) -> Strings<'static> {
-        let mut blob = Vec::new();
+        let mut blob = String::new();
         let mut starts = vec![0u32];
 
         for name in names {
-            blob.extend_from_slice(name.as_ref().as_bytes());
+            blob.push_str(name.as_ref());
             starts.push(blob.len() as u32);
         }
 
@@ -68,6 +69,10 @@ impl<'a> Strings<'a> {
         if *starts.last().expect("checked") as usize != blob.len() {
             return Err(BadTable::TrailingBytes);
         }
+        // The spans tile the blob and each is UTF-8, so the whole is too.
+        let blob = core::str::from_utf8(blob).map_err(|e| BadTable::NotUtf8 {
+            at: e.valid_up_to(),
+        })?;
 
         Ok(Self {
             blob: Cow::Borrowed(blob),
@@ -98,15 +103,15 @@ impl<'a> Strings<'a> {
     pub fn get(&self, index: u32) -> Option<&str> {
         let from = *self.starts.get(index as usize)? as usize;
         let to = *self.starts.get(index as usize + 1)? as usize;
-        // Checked once on construction, so this cannot fail.
-        core::str::from_utf8(self.blob.get(from..to)?).ok()
+        // Spans fall on character boundaries (checked on construction).
+        self.blob.get(from..to)
     }
 
     /// The concatenated names, without their spans.
     #[inline(always)]
     #[must_use]
     pub fn blob(&self) -> &[u8] {
-        &self.blob
+        self.blob.as_bytes()
     }
 
     /// The span boundaries, one longer than [`Strings::len`].

@@ -2521,7 +2521,9 @@ impl Lowering {
         for input in &custom.inputs {
             let saved_loops = std::mem::take(&mut self.loops);
             let first = self.code.len();
-            self.emit(Op::Checkpoint);
+            // At the input's position, which `Expression::position` reads from the chunk's
+            // first instruction (a critterbox patch, see `PATCH.md`).
+            self.emit_at(Op::Checkpoint, input.start_position());
             self.expression(input);
             self.loops = saved_loops;
 

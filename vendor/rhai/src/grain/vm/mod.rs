@@ -30,7 +30,10 @@ use crate::{
 #[cfg(not(feature = "no_function"))]
 use crate::{types::dynamic::Variant, CallFnOptions};
 
+mod accessor;
 mod callback;
+mod kept;
+pub use kept::VmKeep;
 
 #[cfg(not(feature = "no_function"))]
 #[cfg(not(feature = "no_module"))]
@@ -318,10 +321,10 @@ pub struct Fault {
 pub struct Vm<'e> {
     /// [`Engine`] instance.
     engine: &'e Engine,
-    /// Global runtime state.
-    global: GlobalRuntimeState,
-    /// Functions resolution cache.
-    caches: Caches,
+    /// Global runtime state (boxed, so a [`VmKeep`] hands it over by pointer).
+    global: Box<GlobalRuntimeState>,
+    /// Functions resolution cache (boxed, as `global`).
+    caches: Box<Caches>,
     /// Main operating stack.
     stack: Vec<Dynamic>,
     /// One entry per `for` loop currently running.
@@ -377,6 +380,9 @@ pub struct Vm<'e> {
     ///
     /// Set by [`Vm::run_chain`], taken by the next [`Vm::record_fault`].
     pending_slot: Option<u32>,
+    /// The interned parameter names of the function about to be entered, kept by a
+    /// [`VmKeep`] so that a call does not intern them again; taken by the next frame.
+    preset_names: Option<crate::Shared<[ImmutableString]>>,
     /// Steps waiting for the statement that asked for them to end.
     ///
     /// Rhai keeps this in a `defer` per AST node: a `next` runs the statement
@@ -483,11 +489,22 @@ impl<'e> Vm<'e> {
     #[inline(always)]
     #[must_use]
     pub fn with_global_state(engine: &'e Engine, global: GlobalRuntimeState) -> Self {
+        Self::from_parts(engine, Box::new(global), Box::new(Caches::new()), Vec::new())
+    }
+
+    /// A [`Vm`] of the given parts (see [`VmKeep`]).
+    #[inline(always)]
+    fn from_parts(
+        engine: &'e Engine,
+        global: Box<GlobalRuntimeState>,
+        caches: Box<Caches>,
+        stack: Vec<Dynamic>,
+    ) -> Self {
         Self {
             engine,
             global,
-            caches: Caches::new(),
-            stack: Vec::new(),
+            caches,
+            stack,
             iterators: FnArgsVec::new_const(),
             handlers: StaticVec::new_const(),
             #[cfg(not(feature = "unchecked"))]
@@ -498,6 +515,7 @@ impl<'e> Vm<'e> {
             owns_trace: false,
             chain_step: 0,
             pending_slot: None,
+            preset_names: None,
             #[cfg(feature = "debugging")]
             pending_steps: Vec::new(),
         }
@@ -507,7 +525,7 @@ impl<'e> Vm<'e> {
     #[inline(always)]
     #[must_use]
     pub fn into_global_state(self) -> GlobalRuntimeState {
-        self.global
+        *self.global
     }
 
     /// Where the last run failed, inner-most frame first.
@@ -1555,7 +1573,7 @@ impl<'e> Vm<'e> {
             bound = returned;
             result
         } else {
-            let context = (self.engine, pointer.fn_name(), None, &self.global, pos).into();
+            let context = (self.engine, pointer.fn_name(), None, &*self.global, pos).into();
             pointer
                 .call_raw(&context, bound.as_mut(), args)
                 .map_err(|err| err.fill_position(pos))
@@ -1880,57 +1898,35 @@ impl<'e> Vm<'e> {
             }
         }
 
-        // A host type: getter in, setter out.
-        let call = |vm: &mut Self, fn_name: u32, args: &mut [&mut Dynamic]| -> RhaiResult {
-            let fn_name = program
-                .name(fn_name)
-                .ok_or_else(|| malformed(format!("no name {fn_name}")))?;
-            call_engine(
-                vm.engine,
-                &mut vm.global,
-                &mut vm.caches,
-                &mut Scope::new(),
-                fn_name,
-                args,
-                true,
-                true,
-                step_pos,
-            )
-        };
+        // A host type: getter in, setter out (`accessor.rs`).
 
         if last {
             if let Some(value) = value {
                 // `x.p += 1` has to read `p` back through the getter before it
                 // can add to it — the setter takes a finished value.
                 let mut new_val = if matches!(chain.tail, Tail::Assign { op: Some(_) }) {
-                    let mut current = call(self, getter, &mut [target])
-                        .or_else(|err| self.try_index_get(target, key, err, step_pos))?;
+                    let mut current = self.get_property(program, getter, target, key, step_pos)?;
                     self.store(program, chain_op(program, chain)?, &mut current, value, pos)?;
                     current
                 } else {
                     value
                 };
                 // A setter's return value is thrown away, as in Rhai.
-                let _ = call(self, setter, &mut [target, &mut new_val]).or_else(|err| {
-                    self.try_index_set(target, key, &mut new_val, false, err, step_pos)
-                })?;
+                let _ = self.set_property(program, setter, target, key, &mut new_val, false, step_pos)?;
                 return Ok((Dynamic::UNIT, true));
             }
-            let out = call(self, getter, &mut [target])
-                .or_else(|err| self.try_index_get(target, key, err, step_pos))?;
+            let out = self.get_property(program, getter, target, key, step_pos)?;
             return Ok((out, false));
         }
 
         // A getter returns a value, so the rest of the chain works on a
         // temporary. Rhai puts it back through the setter when the sub-chain
         // was a method call, and skips the setter otherwise.
-        let mut temp = call(self, getter, &mut [target])
-            .or_else(|err| self.try_index_get(target, key, err, step_pos))?;
+        let mut temp = self.get_property(program, getter, target, key, step_pos)?;
         let (out, changed) =
             self.walk_chain(program, chain, rest, &mut temp, operands, value, pos)?;
         if changed {
-            let _ = call(self, setter, &mut [target, &mut temp])
-                .or_else(|err| self.try_index_set(target, key, &mut temp, true, err, step_pos))?;
+            let _ = self.set_property(program, setter, target, key, &mut temp, true, step_pos)?;
         }
         Ok((out, changed))
     }
@@ -1959,7 +1955,7 @@ impl<'e> Vm<'e> {
             return None;
         }
         let (func, need_context) = get_builtin_op_assignment_fn(&op.op_assign, target, rhs)?;
-        let context = need_context.then(|| (self.engine, "", None, &self.global, pos()).into());
+        let context = need_context.then(|| (self.engine, "", None, &*self.global, pos()).into());
         Some(
             func(context, &mut [target, rhs])
                 .map(|_| ())
@@ -2342,7 +2338,7 @@ impl<'e> Vm<'e> {
             // Anything else is Rhai's: a native function, a name registered
             // elsewhere, or a pointer it built itself.
             let mut args: FnArgsVec<Dynamic> = self.stack.drain(at + 1..).collect();
-            let context = (self.engine, pointer.fn_name(), None, &self.global, pos).into();
+            let context = (self.engine, pointer.fn_name(), None, &*self.global, pos).into();
             pointer
                 .call_raw(&context, bound.as_mut(), &mut args)
                 .map_err(|err| err.fill_position(pos))
@@ -3135,10 +3131,16 @@ impl<'e> Vm<'e> {
             .as_ref()
             .map_or(0, |dbg| dbg.call_stack().len());
 
-        for (param, slot) in params.iter().zip(first..) {
-            let name = program
-                .name(*param)
-                .ok_or_else(|| malformed(format!("no name {param}")))?;
+        let preset = self.preset_names.take();
+        for (i, (param, slot)) in params.iter().zip(first..).enumerate() {
+            let name = match preset.as_deref().and_then(|names| names.get(i)) {
+                Some(name) => name.clone(),
+                None => self.engine.get_interned_string(
+                    program
+                        .name(*param)
+                        .ok_or_else(|| malformed(format!("no name {param}")))?,
+                ),
+            };
             // Taken, not cloned — Rhai consumes the caller's argument slots,
             // and the caller truncates them away after.
             let value = self
@@ -3146,11 +3148,7 @@ impl<'e> Vm<'e> {
                 .get_mut(slot)
                 .ok_or_else(|| malformed("call with too few arguments".to_string()))?
                 .take();
-            scope.push_entry(
-                self.engine.get_interned_string(name),
-                AccessMode::ReadWrite,
-                value,
-            );
+            scope.push_entry(name, AccessMode::ReadWrite, value);
         }
         let scope_end_len = scope.len();
 
@@ -4364,7 +4362,7 @@ impl<'e> Vm<'e> {
                             .flatten();
                         if let Some((func, need_context)) = builtin {
                             let context = need_context
-                                .then(|| (self.engine, name, None, &self.global, pos()).into());
+                                .then(|| (self.engine, name, None, &*self.global, pos()).into());
                             let value = func(context, &mut [lhs, rhs])
                                 .map_err(|err| err.fill_position(pos()))?;
                             self.stack.truncate(first);
