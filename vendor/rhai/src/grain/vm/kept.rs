@@ -32,17 +32,15 @@ pub struct VmKeep {
 }
 
 impl<'e> Vm<'e> {
-    /// A [`Vm`] made of what `keep` holds (fresh parts when it holds none), its count of
-    /// operations started from zero as [`Vm::new`]'s is. Give the parts back with
-    /// [`Vm::keep`].
+    /// A [`Vm`] made of what `keep` holds (fresh parts when it holds none), its runtime state
+    /// set back to what [`Vm::new`] starts with. Give the parts back with [`Vm::keep`].
     #[inline(always)]
     pub fn from_keep(engine: &'e Engine, keep: &mut VmKeep) -> Self {
         let caches = std::mem::take(&mut keep.caches);
         let stack = std::mem::take(&mut keep.stack);
         match keep.global.take() {
             Some(mut global) => {
-                global.num_operations = Default::default();
-                global.level = 0;
+                fresh(engine, &mut global);
                 let mut vm = Self::from_parts(engine, global, caches, stack);
                 vm.owns_trace = true;
                 vm
@@ -190,4 +188,28 @@ impl<'e> Vm<'e> {
             ))
         })
     }
+}
+
+/// Sets a kept runtime state back to what `Engine::new_global_runtime_state` makes (a call
+/// leaves most of it as it found it; the counts it leaves grown), keeping its allocations and
+/// its fault trace.
+fn fresh(engine: &Engine, global: &mut GlobalRuntimeState) {
+    #[cfg(not(feature = "no_module"))]
+    {
+        global.truncate_imports(0);
+        global.num_modules_loaded = 0;
+        global.embedded_module_resolver = None;
+        #[cfg(not(feature = "no_function"))]
+        {
+            global.constants = None;
+        }
+    }
+    #[cfg(not(feature = "no_function"))]
+    global.lib.clear();
+    global.source = None;
+    global.num_operations = Default::default();
+    global.scope_level = 0;
+    global.level = 0;
+    global.always_search_scope = false;
+    global.tag = engine.default_tag().clone();
 }
