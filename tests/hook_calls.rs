@@ -46,27 +46,29 @@ for i in 0..6 {
     }
 }
 
+/// Lines using a property `Vec` has neither as a field nor by indexer, and the error each gives.
+const MISSING_PROPERTY: [(&str, &str); 3] = [
+    (
+        "v.foo = 3;",
+        "No writable property 'foo' - a setter is not registered for type 'Vec' to handle 'i64'",
+    ),
+    (
+        "let a = v.foo;",
+        "Unknown property 'foo' - a getter is not registered for type 'Vec'",
+    ),
+    (
+        "v.foo += 1;",
+        "Unknown property 'foo' - a getter is not registered for type 'Vec'",
+    ),
+];
+
 /// A property neither a getter, a setter nor an indexer answers is reported as the getter or
 /// setter that is missing: the error is made late (only once the indexer is missing too), but
 /// reads as before.
 #[test]
 fn property_of_a_type_with_no_indexer_names_the_missing_getter_or_setter() {
     let sandbox = Sandbox::new("hook_calls_missing_property");
-    let cases = [
-        (
-            "v.foo = 3;",
-            "No writable property 'foo' - a setter is not registered for type 'Vec' to handle 'i64'",
-        ),
-        (
-            "let a = v.foo;",
-            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
-        ),
-        (
-            "v.foo += 1;",
-            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
-        ),
-    ];
-    for (line, want) in cases {
+    for (line, want) in MISSING_PROPERTY {
         let text = format!(
             "let w = world(#{{ dim: 2, size: vec(20, 10), seed: 1 }});\nlet v = vec(1.0, 2.0);\n{line}\n"
         );
@@ -148,21 +150,7 @@ spawn("writer", #{ pos: vec(5, 5), fixed: true, props: #{ tag: "w" } });
 #[test]
 fn a_missing_property_in_a_hook_names_the_missing_getter_or_setter() {
     let sandbox = Sandbox::new("hook_calls_missing_property_in_hook");
-    let cases = [
-        (
-            "v.foo = 3;",
-            "No writable property 'foo' - a setter is not registered for type 'Vec' to handle 'i64'",
-        ),
-        (
-            "let a = v.foo;",
-            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
-        ),
-        (
-            "v.foo += 1;",
-            "Unknown property 'foo' - a getter is not registered for type 'Vec'",
-        ),
-    ];
-    for (i, (line, want)) in cases.into_iter().enumerate() {
+    for (i, (line, want)) in MISSING_PROPERTY.into_iter().enumerate() {
         let kind = format!("prober{i}");
         sandbox.kind(
             &kind,
