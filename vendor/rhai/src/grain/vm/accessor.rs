@@ -22,22 +22,18 @@ impl Vm<'_> {
         key: &str,
         pos: Position,
     ) -> RhaiResult {
-        let t0 = target.type_name();
+        let (engine, t0) = (self.engine, target.type_name());
         let (getter, hash) = accessor(program, getter, 1)?;
         match self.call_accessor(getter, hash, &mut [target], pos) {
             Ok(Some(value)) => Ok(value),
-            Ok(None) => {
-                let mut index = self.engine.get_interned_string(key).into();
-                self.engine
-                    .call_indexer_get(&mut self.global, &mut self.caches, target, &mut index, pos)
-                    .map_err(|err| match *err {
-                        EvalAltResult::ErrorIndexingType(..) => {
-                            self.engine.getter_not_found(getter, t0, pos)
-                        }
-                        _ => err.fill_position(pos),
-                    })
+            Ok(None) => self.index_get(target, key, pos, || {
+                engine.getter_not_found(getter, t0, pos)
+            }),
+            // A getter failing as a missing one does is followed by the indexer too, as in Rhai.
+            Err(err) if matches!(*err, EvalAltResult::ErrorDotExpr(..)) => {
+                self.index_get(target, key, pos, || err)
             }
-            Err(err) => self.try_index_get(target, key, err, pos),
+            Err(err) => Err(err),
         }
     }
 
@@ -52,34 +48,84 @@ impl Vm<'_> {
         value: &mut Dynamic,
         fail_silently: bool,
         pos: Position,
-    ) -> RhaiResult {
-        let (t0, t1) = (target.type_name(), value.type_name());
+    ) -> RhaiResultOf<()> {
+        let (engine, t0, t1) = (self.engine, target.type_name(), value.type_name());
         let (setter, hash) = accessor(program, setter, 2)?;
         match self.call_accessor(setter, hash, &mut [target, value], pos) {
-            Ok(Some(_)) => Ok(Dynamic::UNIT),
-            Ok(None) => {
-                let mut index = self.engine.get_interned_string(key).into();
-                match self.engine.call_indexer_set(
-                    &mut self.global,
-                    &mut self.caches,
-                    target,
-                    &mut index,
-                    value,
-                    true,
-                    pos,
-                ) {
-                    Ok(_) => Ok(Dynamic::UNIT),
-                    Err(err) if matches!(*err, EvalAltResult::ErrorIndexingType(..)) => {
-                        if fail_silently {
-                            Ok(Dynamic::UNIT)
-                        } else {
-                            Err(self.engine.setter_not_found(setter, t0, t1, pos))
-                        }
-                    }
-                    Err(err) => Err(err.fill_position(pos)),
-                }
+            Ok(Some(_)) => Ok(()),
+            Ok(None) => self.index_set(target, key, value, fail_silently, pos, || {
+                engine.setter_not_found(setter, t0, t1, pos)
+            }),
+            Err(err) if matches!(*err, EvalAltResult::ErrorDotExpr(..)) => {
+                self.index_set(target, key, value, fail_silently, pos, || err)
             }
-            Err(err) => self.try_index_set(target, key, value, fail_silently, err, pos),
+            Err(err) => Err(err),
+        }
+    }
+
+    /// `target["key"]`, or `missing()` when the type has no string indexer.
+    fn index_get(
+        &mut self,
+        target: &mut Dynamic,
+        key: &str,
+        pos: Position,
+        missing: impl FnOnce() -> Box<EvalAltResult>,
+    ) -> RhaiResult {
+        #[cfg(not(any(feature = "no_index", feature = "no_object")))]
+        {
+            let mut index = self.engine.get_interned_string(key).into();
+            self.engine
+                .call_indexer_get(&mut self.global, &mut self.caches, target, &mut index, pos)
+                .map_err(|err| match *err {
+                    EvalAltResult::ErrorIndexingType(..) => missing(),
+                    _ => err.fill_position(pos),
+                })
+        }
+        #[cfg(any(feature = "no_index", feature = "no_object"))]
+        {
+            let _ = (target, key, pos);
+            Err(missing())
+        }
+    }
+
+    /// `target["key"] = value`, or `missing()` when the type has no string indexer (nothing
+    /// with `fail_silently`).
+    fn index_set(
+        &mut self,
+        target: &mut Dynamic,
+        key: &str,
+        value: &mut Dynamic,
+        fail_silently: bool,
+        pos: Position,
+        missing: impl FnOnce() -> Box<EvalAltResult>,
+    ) -> RhaiResultOf<()> {
+        #[cfg(not(any(feature = "no_index", feature = "no_object")))]
+        {
+            let mut index = self.engine.get_interned_string(key).into();
+            match self.engine.call_indexer_set(
+                &mut self.global,
+                &mut self.caches,
+                target,
+                &mut index,
+                value,
+                true,
+                pos,
+            ) {
+                Ok(_) => Ok(()),
+                Err(err) if matches!(*err, EvalAltResult::ErrorIndexingType(..)) => {
+                    if fail_silently {
+                        Ok(())
+                    } else {
+                        Err(missing())
+                    }
+                }
+                Err(err) => Err(err.fill_position(pos)),
+            }
+        }
+        #[cfg(any(feature = "no_index", feature = "no_object"))]
+        {
+            let _ = (target, key, value, fail_silently, pos);
+            Err(missing())
         }
     }
 

@@ -109,34 +109,10 @@ impl<'e> Vm<'e> {
         }
         let orig_scope_len = scope.len();
         let result = self.with_environment(program, None, |vm| {
-            vm.clear_faults();
-            #[cfg(feature = "debugging")]
-            vm.pending_steps.clear();
-
             let first = vm.stack.len();
             args.parse(&mut vm.stack);
             let argc = vm.stack.len() - first;
-            let found = match fns.iter().find(|(n, c, ..)| *c == argc && n.as_str() == name) {
-                Some((_, _, index, names)) => Some((*index, names.clone())),
-                None => program
-                    .functions()
-                    .iter()
-                    .position(|f| {
-                        f.params.len() == argc
-                            && f.this_type.is_none()
-                            && program.name(f.name) == Some(name)
-                    })
-                    .map(|index| {
-                        let names: Shared<[ImmutableString]> = program.functions()[index]
-                            .params
-                            .iter()
-                            .map(|&p| vm.engine.get_interned_string(program.name(p).unwrap_or("")))
-                            .collect();
-                        fns.push((name.into(), argc, index, names.clone()));
-                        (index, names)
-                    }),
-            };
-            let Some((index, names)) = found else {
+            let Some((index, names)) = kept_function(vm.engine, fns, program, name, argc) else {
                 vm.stack.truncate(first);
                 return Err(Box::new(EvalAltResult::ErrorFunctionNotFound(
                     format!("{name} ({argc} args)"),
@@ -144,23 +120,20 @@ impl<'e> Vm<'e> {
                 )));
             };
             let function = &program.functions()[index];
-
-            let restore = std::mem::replace(&mut vm.global.level, 0);
             vm.preset_names = Some(names);
-            let (result, _) = vm.call_compiled_with_this(
+            let (result, _) = vm.call_function_on_stack(
                 program,
                 name,
                 &function.params,
                 function.chunk,
                 first,
+                0,
                 scope,
                 options.rewind_scope,
                 Position::NONE,
                 None,
             );
             vm.preset_names = None;
-            vm.global.level = restore;
-            vm.stack.truncate(first);
 
             #[cfg(feature = "debugging")]
             let result = vm.at_end(scope).and(result);
@@ -171,23 +144,39 @@ impl<'e> Vm<'e> {
             scope.rewind(orig_scope_len);
         }
 
-        let result = result.or_else(|err| match *err {
+        let value = result.or_else(|err| match *err {
             EvalAltResult::Exit(out, ..) => Ok(out),
             EvalAltResult::ErrorInFunctionCall(fn_name, _, inner, _) if fn_name == name => {
                 Err(inner)
             }
             _ => Err(err),
         })?;
-        result.try_cast_result().map_err(|value| {
-            Box::new(EvalAltResult::ErrorMismatchOutputType(
-                self.engine
-                    .map_type_name(core::any::type_name::<T>())
-                    .into(),
-                self.engine.map_type_name(value.type_name()).into(),
-                Position::NONE,
-            ))
-        })
+        self.cast_result(value)
     }
+}
+
+/// The index of `program`'s function `name` of `argc` parameters, and its parameters' interned
+/// names: from `fns` when an earlier call found it, else looked up and added there.
+fn kept_function(
+    engine: &Engine,
+    fns: &mut Vec<(ImmutableString, usize, usize, Shared<[ImmutableString]>)>,
+    program: &Program,
+    name: &str,
+    argc: usize,
+) -> Option<(usize, Shared<[ImmutableString]>)> {
+    if let Some((.., index, names)) = fns.iter().find(|(n, c, ..)| *c == argc && n == name) {
+        return Some((*index, names.clone()));
+    }
+    let index = program.functions().iter().position(|f| {
+        f.params.len() == argc && f.this_type.is_none() && program.name(f.name) == Some(name)
+    })?;
+    let names: Shared<[ImmutableString]> = program.functions()[index]
+        .params
+        .iter()
+        .map(|&p| engine.get_interned_string(program.name(p).unwrap_or("")))
+        .collect();
+    fns.push((name.into(), argc, index, names.clone()));
+    Some((index, names))
 }
 
 /// Sets a kept runtime state back to what `Engine::new_global_runtime_state` makes (a call

@@ -650,16 +650,35 @@ impl<'e> Vm<'e> {
         pos: Position,
         this: Option<Dynamic>,
     ) -> (RhaiResult, Option<Dynamic>) {
+        // `call_compiled` takes its arguments off the operand stack, where a
+        // compiled call site would already have put them.
+        let first = self.stack.len();
+        self.stack.extend(args);
+        self.call_function_on_stack(
+            program, name, params, chunk, first, level, scope, rewind, pos, this,
+        )
+    }
+
+    /// The same, with the arguments already on the operand stack from `first` up (a critterbox
+    /// patch: [`Vm::call_fn_kept`] parses them there).
+    pub(crate) fn call_function_on_stack(
+        &mut self,
+        program: &Program,
+        name: &str,
+        params: &[u32],
+        chunk: Chunk,
+        first: usize,
+        level: usize,
+        scope: &mut Scope,
+        rewind: bool,
+        pos: Position,
+        this: Option<Dynamic>,
+    ) -> (RhaiResult, Option<Dynamic>) {
         // An entry point in its own right so the trace starts here rather than at `run_main`.
         self.clear_faults();
         // A step a previous run left waiting is not this one's to honour.
         #[cfg(feature = "debugging")]
         self.pending_steps.clear();
-
-        // `call_compiled` takes its arguments off the operand stack, where a
-        // compiled call site would already have put them.
-        let first = self.stack.len();
-        self.stack.extend(args);
 
         let restore = mem::replace(&mut self.global.level, level);
         let (result, this) = self.call_compiled_with_this(
@@ -821,7 +840,13 @@ impl<'e> Vm<'e> {
             scope.rewind(orig_scope_len);
         }
 
-        result?.try_cast_result().map_err(|value| {
+        self.cast_result(result?)
+    }
+
+    /// A call's value as the type its caller asked for.
+    #[cfg(not(feature = "no_function"))]
+    fn cast_result<T: Variant + Clone>(&self, value: Dynamic) -> RhaiResultOf<T> {
+        value.try_cast_result().map_err(|value| {
             Box::new(EvalAltResult::ErrorMismatchOutputType(
                 self.engine
                     .map_type_name(core::any::type_name::<T>())
@@ -1751,87 +1776,6 @@ impl<'e> Vm<'e> {
         }
     }
 
-    // Try to get a property through an indexer.
-    //
-    // This requires `no_index` and `no_object` to be off,
-    // otherwise it just passes the error through.
-    fn try_index_get(
-        &mut self,
-        target: &mut Dynamic,
-        key: &str,
-        err: Box<EvalAltResult>,
-        pos: Position,
-    ) -> RhaiResult {
-        #[cfg(not(any(feature = "no_index", feature = "no_object")))]
-        return match *err {
-            EvalAltResult::ErrorDotExpr(..) => {
-                let mut index = self.engine.get_interned_string(key).into();
-                self.engine
-                    .call_indexer_get(&mut self.global, &mut self.caches, target, &mut index, pos)
-                    .map_err(|err2| match *err2 {
-                        EvalAltResult::ErrorIndexingType(..) => err,
-                        _ => err2.fill_position(pos),
-                    })
-            }
-            _ => Err(err),
-        };
-        #[cfg(any(feature = "no_index", feature = "no_object"))]
-        {
-            let _ = (target, key, pos);
-            return Err(err);
-        }
-    }
-
-    // Try to set a property through an index setter.
-    //
-    // This requires `no_index` and `no_object` to be off,
-    // otherwise it just passes the error through.
-    fn try_index_set(
-        &mut self,
-        target: &mut Dynamic,
-        key: &str,
-        value: &mut Dynamic,
-        fail_silently: bool,
-        err: Box<EvalAltResult>,
-        pos: Position,
-    ) -> RhaiResult {
-        #[cfg(not(any(feature = "no_index", feature = "no_object")))]
-        return match *err {
-            EvalAltResult::ErrorDotExpr(..) => {
-                let mut index = self.engine.get_interned_string(key).into();
-                match self
-                    .engine
-                    .call_indexer_set(
-                        &mut self.global,
-                        &mut self.caches,
-                        target,
-                        &mut index,
-                        value,
-                        true,
-                        pos,
-                    )
-                    .map(|_| ())
-                {
-                    Ok(()) => Ok(Dynamic::UNIT),
-                    Err(err2) if matches!(*err2, EvalAltResult::ErrorIndexingType(..)) => {
-                        if fail_silently {
-                            Ok(Dynamic::UNIT)
-                        } else {
-                            Err(err)
-                        }
-                    }
-                    Err(err2) => Err(err2.fill_position(pos)),
-                }
-            }
-            _ => Err(err),
-        };
-        #[cfg(any(feature = "no_index", feature = "no_object"))]
-        {
-            let _ = (target, key, value, fail_silently, pos);
-            return Err(err);
-        }
-    }
-
     /// `.name`, which is a key on a map and a getter call on anything else.
     #[allow(clippy::too_many_arguments)]
     fn walk_property(
@@ -1912,7 +1856,7 @@ impl<'e> Vm<'e> {
                     value
                 };
                 // A setter's return value is thrown away, as in Rhai.
-                let _ = self.set_property(program, setter, target, key, &mut new_val, false, step_pos)?;
+                self.set_property(program, setter, target, key, &mut new_val, false, step_pos)?;
                 return Ok((Dynamic::UNIT, true));
             }
             let out = self.get_property(program, getter, target, key, step_pos)?;
@@ -1926,7 +1870,7 @@ impl<'e> Vm<'e> {
         let (out, changed) =
             self.walk_chain(program, chain, rest, &mut temp, operands, value, pos)?;
         if changed {
-            let _ = self.set_property(program, setter, target, key, &mut temp, true, step_pos)?;
+            self.set_property(program, setter, target, key, &mut temp, true, step_pos)?;
         }
         Ok((out, changed))
     }
