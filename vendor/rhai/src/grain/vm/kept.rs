@@ -26,10 +26,13 @@ pub struct VmKeep {
     stack: Vec<Dynamic>,
     /// The address and debug id of the program the entries below were made for.
     program: Option<(usize, u128)>,
-    /// Functions called so far: name, number of parameters, index among the program's
-    /// functions, and the parameters' interned names.
-    fns: Vec<(ImmutableString, usize, usize, Shared<[ImmutableString]>)>,
+    /// Functions called so far.
+    fns: Vec<KeptFn>,
 }
+
+/// A function called through a [`VmKeep`]: its name, number of parameters, index among the
+/// program's functions, and its parameters' interned names.
+type KeptFn = (ImmutableString, usize, usize, Shared<[ImmutableString]>);
 
 impl<'e> Vm<'e> {
     /// A [`Vm`] made of what `keep` holds (fresh parts when it holds none), its runtime state
@@ -97,7 +100,7 @@ impl<'e> Vm<'e> {
 
     fn call_kept<T: Variant + Clone>(
         &mut self,
-        fns: &mut Vec<(ImmutableString, usize, usize, Shared<[ImmutableString]>)>,
+        fns: &mut Vec<KeptFn>,
         options: CallFnOptions,
         scope: &mut Scope,
         program: &Program,
@@ -159,7 +162,7 @@ impl<'e> Vm<'e> {
 /// names: from `fns` when an earlier call found it, else looked up and added there.
 fn kept_function(
     engine: &Engine,
-    fns: &mut Vec<(ImmutableString, usize, usize, Shared<[ImmutableString]>)>,
+    fns: &mut Vec<KeptFn>,
     program: &Program,
     name: &str,
     argc: usize,
