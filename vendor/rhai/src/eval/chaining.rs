@@ -528,7 +528,7 @@ impl Engine {
                             let t0 = args[0].type_name();
                             let found = self.exec_native_fn_call_or_none(
                                 global, caches, getter, None, *hash_get, args, is_ref_mut, false,
-                                *pos,
+                                false, *pos,
                             );
                             // Try an indexer if property does not exist; if neither exists, the
                             // getter's error (made only then: a critterbox patch, see `PATCH.md`)
@@ -567,7 +567,8 @@ impl Engine {
                         let args = &mut [target.as_mut(), &mut new_val];
                         let (t0, t1) = (args[0].type_name(), args[1].type_name());
                         let found = self.exec_native_fn_call_or_none(
-                            global, caches, setter, None, *hash_set, args, is_ref_mut, false, *pos,
+                            global, caches, setter, None, *hash_set, args, is_ref_mut, false, false,
+                            *pos,
                         );
                         // Try an indexer if property does not exist; if neither exists, the
                         // setter's error (made only then: a critterbox patch, see `PATCH.md`)
@@ -603,7 +604,8 @@ impl Engine {
                         let args = &mut [target.as_mut()];
                         let t0 = args[0].type_name();
                         let found = self.exec_native_fn_call_or_none(
-                            global, caches, getter, None, *hash_get, args, is_ref_mut, false, *pos,
+                            global, caches, getter, None, *hash_get, args, is_ref_mut, false, false,
+                            *pos,
                         );
                         // Try an indexer if property does not exist; if neither exists, the
                         // getter's error (made only then: a critterbox patch, see `PATCH.md`)

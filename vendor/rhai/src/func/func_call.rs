@@ -550,6 +550,7 @@ impl Engine {
             args,
             is_ref_mut,
             non_volatile_only,
+            true,
             pos,
         )? {
             Some(result) => Ok(result),
@@ -559,6 +560,8 @@ impl Engine {
 
     /// [`Engine::exec_native_fn_call`], with `None` where no function is found, so a property
     /// access can try an indexer before any error is made (a critterbox patch, see `PATCH.md`).
+    /// `special` says whether `name` may be one the engine treats itself (`type_of`,
+    /// `is_def_var`, `print`...): false for a property accessor (`get$p`), whose name never is.
     pub(crate) fn exec_native_fn_call_or_none(
         &self,
         global: &mut GlobalRuntimeState,
@@ -569,6 +572,7 @@ impl Engine {
         args: &mut FnCallArgs,
         is_ref_mut: bool,
         non_volatile_only: bool,
+        special: bool,
         pos: Position,
     ) -> RhaiResultOf<Option<(Dynamic, bool)>> {
         self.track_operation(global, pos)?;
@@ -578,8 +582,10 @@ impl Engine {
         #[cfg(not(feature = "unchecked"))]
         ensure_no_data_race(name, args, is_ref_mut)?;
 
-        if let Some(result) = self.exec_syntactic_fn_call(global, caches, name, args, pos)? {
-            return Ok(Some((result, false)));
+        if special {
+            if let Some(result) = self.exec_syntactic_fn_call(global, caches, name, args, pos)? {
+                return Ok(Some((result, false)));
+            }
         }
 
         // Check if function access already in the cache
@@ -683,6 +689,10 @@ impl Engine {
             #[cfg(not(feature = "unchecked"))]
             if is_ref_mut && !args.is_empty() {
                 self.check_data_size(&*args[0], pos)?;
+            }
+
+            if !special {
+                return Ok(Some((result, is_method)));
             }
 
             // See if the function match print/debug (which requires special processing)

@@ -149,6 +149,7 @@ impl Vm<'_> {
             args,
             true,
             false,
+            false,
             pos,
         );
         self.global.level -= 1;
