@@ -1,11 +1,11 @@
 //! Critters: the disks (2D) and spheres (3D) that move and collide, and the walls they bounce off.
 
-use crate::kind::KindId;
+pub use crate::ids::CritterId;
+use crate::ids::KindId;
 use crate::vector::Vector;
 use crate::wall::WallBox;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::fmt;
 use std::sync::Arc;
 
 /// Collide priority of the lowest critters (Pop's CP_MINIMUM).
@@ -33,35 +33,6 @@ pub const PRIORITY_NAMES: [(&str, f64); 7] = [
     ("CP_WALL", CP_WALL),
     ("CP_MAXIMUM", CP_MAXIMUM),
 ];
-
-/// A stable critter id: a slot index and the generation of that slot.
-///
-/// When a critter dies its slot may be reused, but with the next generation, so the id of a dead
-/// critter never names a new one. Ids order by index, then generation.
-#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[repr(C)]
-pub struct CritterId {
-    /// Slot index in the world's critter set.
-    pub index: u32,
-    /// How many times the slot has been reused.
-    pub generation: u32,
-}
-
-impl fmt::Debug for CritterId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "#{}", self.index)?;
-        if self.generation > 0 {
-            write!(f, "v{}", self.generation)?;
-        }
-        Ok(())
-    }
-}
-
-impl fmt::Display for CritterId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        fmt::Debug::fmt(self, f)
-    }
-}
 
 /// A user property value, for the map every critter carries.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -12,7 +12,7 @@
 //! stored never shows.
 
 use crate::critter::{Critter, CritterId, Traits};
-use crate::hash::critters::Statics;
+use crate::hash::statics::Statics;
 use crate::vector::Vector;
 use std::sync::Arc;
 
@@ -20,7 +20,7 @@ use std::sync::Arc;
 ///
 /// Every mutable accessor marks the critters as possibly changed in any field, so the next
 /// state hash reads them whole; the engine's own `*_moving` accessors, which write positions,
-/// velocities and rule classes only, do not (see `hash::critters::Statics`).
+/// velocities and rule classes only, do not (see `hash::statics::Statics`).
 #[derive(Clone, Debug)]
 pub struct CritterSet<V: Vector> {
     /// The critters by slot.

@@ -1,6 +1,6 @@
 //! The library's errors. Each names what is wrong, where, and what to do.
 
-use crate::critter::CritterId;
+use crate::ids::CritterId;
 
 /// Everything that can go wrong in the library.
 #[derive(Debug, thiserror::Error)]

@@ -4,16 +4,13 @@
 //! implementation of [`KindHooks`]. The native behaviour is the trait's default methods, so
 //! `impl KindHooks for ()` is the plain ball; scripted kinds implement the same trait.
 
-use crate::context::{CollideCtx, HookContact, UpdateCtx};
 use crate::critter::{Critter, CP_CRITTER, CP_WALL};
 use crate::error::Error;
+pub use crate::ids::KindId;
+use crate::step::access::{CollideCtx, HookContact, UpdateCtx};
 use crate::vector::Vector;
 use std::collections::BTreeMap;
 use std::rc::Rc;
-
-/// Index of a kind in a world's [`KindSet`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct KindId(pub u32);
 
 /// Pop's `collidesWith` answer, from one critter about another.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -26,18 +26,20 @@
 // The engine's parts, reached through the re-exports below.
 mod border;
 mod contact;
-mod context;
+
 mod critter;
 mod critter_set;
+mod default_response;
 mod error;
 mod hash;
+mod ids;
 mod kind;
-mod pairs;
+mod pair_order;
 mod parallel;
 mod prefetch;
-mod response;
 mod rng;
 mod rules;
+mod step;
 mod tolerance;
 mod vector;
 mod wall;
@@ -60,12 +62,12 @@ pub mod world;
 
 pub use border::{Border, Topology};
 pub use broad_phase::BroadPhaseMode;
-pub use context::{Access, CollideCtx, CollisionEvent, HookContact, StepEvents, UpdateCtx};
 pub use critter::{
     Critter, CritterId, CritterSpec, PropValue, Props, Shape, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
     CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
 };
 pub use critter_set::CritterSet;
+pub use default_response::Hit;
 pub use error::{Error, ScriptError};
 pub use glam;
 pub use kind::{
@@ -73,9 +75,10 @@ pub use kind::{
 };
 pub use method::Method;
 pub use parallel::PARALLEL_MIN;
-pub use response::Hit;
 pub use rng::Rng;
 pub use rules::RuleCache;
+pub use step::access::{Access, CollideCtx, HookContact, UpdateCtx};
+pub use step::events::{CollisionEvent, StepEvents};
 #[doc(hidden)]
 pub use vector::Align64;
 pub use vector::Vector;

@@ -209,6 +209,12 @@ impl Vector for DVec3 {
     }
 }
 
+/// "(1, 2.5)" or "(1, 2.5, 0)".
+pub(crate) fn fmt_vec<V: Vector>(v: V) -> String {
+    let parts: Vec<String> = (0..V::DIM).map(|a| format!("{}", v.get(a))).collect();
+    format!("({})", parts.join(", "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,8 +2,8 @@
 
 use crate::error::Error;
 use crate::tolerance::ROUNDING_MARGIN;
+use crate::vector::fmt_vec;
 use crate::vector::Vector;
-use crate::world::fmt_vec;
 use glam::{DMat3, DVec2, DVec3};
 
 /// Pop's default wall thickness.

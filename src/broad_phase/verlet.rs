@@ -321,7 +321,7 @@ impl<V: Vector> BroadPhase<V> {
             }
             self.rebuild_list(objs, topo);
         } else if self.list.sort_wanted && !self.list.sorted {
-            crate::pairs::sort_pairs(&mut self.list.pairs, objs.slots());
+            crate::pair_order::sort_pairs(&mut self.list.pairs, objs.slots());
             self.list.sorted = true;
         }
         self.list.served = self.list.served.saturating_add(1);

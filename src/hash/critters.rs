@@ -29,22 +29,13 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx512;
+use super::statics::StaticHash;
+pub use super::statics::{Statics, MOVING, STATIC, WORDS};
 use super::{mix, scramble, StateHasher};
 use crate::critter::{Critter, PropValue};
 use crate::critter_set::InIdOrder;
 use crate::vector::Vector;
-use std::sync::{Mutex, PoisonError};
-
-/// Words per critter.
-pub const WORDS: usize = 16;
-
-/// The first `MOVING` words of a critter hold everything a step changes when no hook writes to
-/// the critters: position, velocity, radius and mass (and in 2D id and flags).
-pub const MOVING: usize = 8;
-
-/// The words after the first [`MOVING`]: kind, priority, restitution, health (and in 3D id and
-/// flags).
-pub const STATIC: usize = WORDS - MOVING;
+use std::sync::PoisonError;
 
 /// Interleaved sets of lanes for the moving words, and of sums for the totals.
 pub const SETS: usize = 4;
@@ -323,49 +314,6 @@ pub fn portable_moving_pass<V: Vector>(slots: InIdOrder<'_, V>) -> MovingPass<V>
         lanes,
         energy,
         momentum,
-    }
-}
-
-/// What the last whole pass over a set of critters left in the static lanes and in the
-/// properties' hash.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct StaticHash {
-    lanes: [u64; STATIC],
-    props: u64,
-}
-
-/// The static lanes of a critter set, kept between hashes.
-///
-/// A step without hooks writes only positions and velocities (and the rule class, which is not
-/// hashed), so the next hash needs only the first [`MOVING`] words of each critter: one cache
-/// line of a 2D critter instead of two. The critter set drops what is kept on every write that
-/// could change anything else: insert, remove, and every mutable accessor but the engine's own
-/// `*_moving` ones, which write positions, velocities and rule classes only. Debug builds (the
-/// tests) check every reuse against a whole pass.
-#[derive(Debug, Default)]
-pub struct Statics(Mutex<Option<StaticHash>>);
-
-impl Clone for Statics {
-    /// A copy starts with nothing kept (its first hash is a whole pass).
-    fn clone(&self) -> Self {
-        Statics::default()
-    }
-}
-
-impl Statics {
-    /// Forgets what is kept: the next hash reads every word again.
-    #[inline]
-    pub(crate) fn forget(&mut self) {
-        *self.0.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
-    }
-
-    /// True when the next hash can reuse the kept lanes.
-    #[cfg(test)]
-    pub(crate) fn is_kept(&self) -> bool {
-        self.0
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .is_some()
     }
 }
 

@@ -8,6 +8,7 @@
 //! where the CPU has it); this hasher takes the world's few other words and that pass's lanes.
 
 pub mod critters;
+pub mod statics;
 
 #[cfg(target_arch = "x86_64")]
 mod avx512;

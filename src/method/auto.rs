@@ -30,8 +30,8 @@ use crate::method::flight;
 use crate::method::solve::{Sweeps, LAYERS_PER_SWEEP};
 use crate::method::swept::{count_fast, displacement, motion_scale, MotionScale, SWEEP_FRACTION};
 use crate::method::Method;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// The sweeps of the `solve:n` step `auto` takes under gravity (the stability table's
 /// `solve:8`), at least.

@@ -20,9 +20,9 @@ use crate::method::auto::{MOST_SOLVE_SUBSTEPS, SOLVE_FRACTION};
 use crate::method::flight::SKIN;
 use crate::method::toi::{toi_ball_ball, toi_wall_ball};
 use crate::rules::roles_order;
+use crate::step::state::{at_step, State};
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::state::{at_step, State};
-use crate::world::stats::StepStats;
 
 /// Bullets are at most this share of the moving critters; a scene with more is swept whole.
 pub const BULLET_SHARE: f64 = 0.125;
@@ -148,7 +148,7 @@ fn gather<V: Vector>(
     out.clear();
     let half = v * (0.5 * left);
     let reach = half.length() + r;
-    let at = crate::world::neighbours::Scope {
+    let at = crate::step::neighbours::Scope {
         critters: &state.critters,
         kinds: &state.kinds,
         topo: &state.topo,

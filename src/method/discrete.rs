@@ -4,10 +4,10 @@
 use super::sleep::Sleep;
 use super::solve::{self, Sweeps};
 use crate::error::Error;
+use crate::step::state::State;
+use crate::step::stats::{timed, StepStats};
+use crate::step::{motion, pairs::MoveReport, pairs::Pairs, response};
 use crate::vector::Vector;
-use crate::world::stages::{motion, pairs::MoveReport, pairs::Pairs, response};
-use crate::world::state::State;
-use crate::world::stats::{timed, StepStats};
 
 /// How the touching pairs are answered.
 pub(crate) enum Respond<'a, V: Vector> {

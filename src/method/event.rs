@@ -14,10 +14,10 @@
 use super::flight;
 use crate::error::Error;
 use crate::method::swept::{finish_after_budget, motion_scale, Overrun, SWEEP_FRACTION};
+use crate::step::pairs::Pairs;
+use crate::step::state::State;
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::stages::pairs::Pairs;
-use crate::world::state::State;
-use crate::world::stats::StepStats;
 
 /// One event-driven step of exactly dt (after the update hooks, before the lifecycle).
 pub(crate) fn step<V: Vector>(

@@ -36,9 +36,9 @@
 use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::Critter;
+use crate::step::state::State;
 use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// A disk approaching a support slower than this many steps of gravity (`|g| dt`) rests on it.
 pub const RESTING_STEPS: f64 = 2.0;

@@ -20,8 +20,8 @@
 
 use super::islands::{Islands, Regime, ASLEEP, NO_ISLAND};
 use super::Method;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// A slot's group: the Pop-step group, the event group, or none (walls, fixed, empty).
 pub(crate) const POP_GROUP: u8 = 0;

@@ -26,11 +26,11 @@ pub(crate) mod discrete;
 pub(crate) mod event;
 pub(crate) mod flight;
 pub mod islands;
+pub(crate) mod method_state;
 pub mod mixed;
 mod queue;
 pub mod sleep;
 pub mod solve;
-pub(crate) mod state;
 pub(crate) mod swept;
 pub mod toi;
 

@@ -37,13 +37,13 @@
 //! step until something wakes them ([`crate::method::sleep`]); their contacts' impulses are kept
 //! for then.
 
-use crate::context::CollisionEvent;
 use crate::error::Error;
 use crate::method::sleep::Sleep;
-use crate::pairs::{pair_key, unpair_key};
+use crate::pair_order::{pair_key, unpair_key};
+use crate::step::events::CollisionEvent;
+use crate::step::pairs::Pairs;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::stages::pairs::Pairs;
-use crate::world::state::State;
 
 /// Sweeps of `solve` when the method is named without a count.
 pub const DEFAULT_SWEEPS: u32 = 8;
@@ -248,7 +248,7 @@ pub(crate) fn respond<V: Vector>(
         if !ca.alive || !cb.alive {
             continue;
         }
-        let Some(c) = crate::response::contact_between(&state.topo, ca, cb) else {
+        let Some(c) = crate::default_response::contact_between(&state.topo, ca, cb) else {
             continue;
         };
         let (ba, bb) = (s.bodies[a as usize], s.bodies[b as usize]);

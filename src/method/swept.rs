@@ -16,10 +16,10 @@
 use super::discrete::{self, Respond};
 use super::flight;
 use crate::error::Error;
+use crate::step::pairs::Pairs;
+use crate::step::state::State;
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::stages::pairs::Pairs;
-use crate::world::state::State;
-use crate::world::stats::StepStats;
 
 /// A step is swept when some critter moves more than this fraction of the smallest disk radius
 /// or wall thickness.

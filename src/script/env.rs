@@ -1,15 +1,18 @@
 //! What a script may do to the world it runs in: the [`Env`] trait, and its implementations for
 //! the whole [`World`] (scene setup, `on_step`) and for a hook's [`Access`] (inside a step). The
-//! read-only view `collides_with` gets is in [`super::kind`].
+//! read-only view `collides_with` gets is in [`super::kind_file`].
 
 use crate::border::Topology;
-use crate::context::{Access, SpawnOrigin};
 use crate::critter::{Critter, CritterId, CritterSpec, Props};
 use crate::error::Error;
 use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
+use crate::step::access::Access;
+use crate::step::pending::OnOverlap;
+use crate::step::pending::SpawnOrigin;
+use crate::step::spawn::Placed;
 use crate::vector::Vector;
-use crate::world::{OnOverlap, Placed, World};
+use crate::world::World;
 
 /// What a script may do to the world it runs in.
 pub(crate) trait Env<V: Vector> {
@@ -40,13 +43,13 @@ pub(crate) trait Env<V: Vector> {
     fn critters_of(&self, kind: KindId) -> Vec<CritterId>;
     fn touches(&self, a: CritterId, b: CritterId) -> bool {
         match (self.critter(a), self.critter(b)) {
-            (Some(x), Some(y)) => crate::response::touches(self.topology(), x, y),
+            (Some(x), Some(y)) => crate::default_response::touches(self.topology(), x, y),
             _ => false,
         }
     }
     fn contains(&self, outer: CritterId, inner: CritterId) -> bool {
         match (self.critter(outer), self.critter(inner)) {
-            (Some(o), Some(i)) => crate::response::contains(self.topology(), o, i),
+            (Some(o), Some(i)) => crate::default_response::contains(self.topology(), o, i),
             _ => false,
         }
     }

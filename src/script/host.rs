@@ -97,7 +97,7 @@ pub(crate) struct Host {
     /// The runtime this host belongs to (for loading kinds from scripts).
     runtime: Weak<Runtime>,
     /// While a kind file's top level runs: what it declares.
-    pub kind_decl: RefCell<Option<super::kind::KindDecl>>,
+    pub kind_decl: RefCell<Option<super::kind_file::KindDecl>>,
     /// Set by `world.stop(reason)`.
     pub stop: RefCell<Option<String>>,
     /// Steps the scene asked for (`world(#{ steps: ... })`).
@@ -108,7 +108,7 @@ pub(crate) struct Host {
     /// kept whole while rhai carries its text up through the calling script.
     pub stashed: RefCell<Option<Box<ScriptError>>>,
     /// The script hooks running, innermost last (for `parent_*` and `contact.impulse`).
-    pub frames: RefCell<Vec<super::kind::HookFrame>>,
+    pub frames: RefCell<Vec<super::kind_file::HookFrame>>,
 }
 
 /// Puts a host's previous target back when dropped, also when a script call unwinds.

@@ -9,7 +9,7 @@
 //! `check` reports the names that resolve to no kind ([`super::lint`]).
 
 use super::host::Dim;
-use super::kind::load_into;
+use super::kind_file::load_into;
 use super::Runtime;
 use crate::error::Error;
 use crate::world::World;

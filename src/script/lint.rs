@@ -8,13 +8,13 @@
 //! and a kind otherwise (as `critterbox test` and `run` take them).
 
 use super::kind_refs::{self, closest, edit_distance};
-use super::{kind, scene, Runtime, ScriptOptions};
+use super::{kind_file, scene, Runtime, ScriptOptions};
 use crate::error::{Error, ScriptError};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// The hooks a kind may define, with the numbers of parameters each may take.
-const KIND_HOOKS: &[(&str, &[usize])] = &kind::HOOKS;
+const KIND_HOOKS: &[(&str, &[usize])] = &kind_file::HOOKS;
 
 /// The hook a scene may define.
 const SCENE_HOOKS: &[(&str, &[usize])] = &[("on_step", &[1])];
@@ -237,7 +237,7 @@ pub fn check_file(path: &Path, options: &ScriptOptions) -> FileCheck {
         FileType::Scene => {
             super::load_scene(path, &[], options).map(|scene| super::scene_ok(&file, &scene))
         }
-        FileType::Kind => kind::load_def(&rt, &file).map(|def| {
+        FileType::Kind => kind_file::load_def(&rt, &file).map(|def| {
             let hooks: Vec<&str> = def.hook_names().collect();
             format!(
                 "{file}: kind '{}' ok (hooks: {})",

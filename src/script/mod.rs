@@ -15,8 +15,8 @@ pub(crate) mod api;
 pub(crate) mod env;
 pub(crate) mod errors;
 pub(crate) mod host;
-pub(crate) mod kind;
 pub(crate) mod kind_calls;
+pub(crate) mod kind_file;
 pub(crate) mod kind_refs;
 pub mod lint;
 pub(crate) mod reload;
@@ -99,7 +99,7 @@ pub(crate) struct Runtime {
     /// Folders searched for `name.rhai` when a kind is asked for by name.
     pub kind_dirs: Vec<PathBuf>,
     /// Script kinds by name.
-    pub kinds: RefCell<BTreeMap<String, Rc<kind::ScriptKindDef>>>,
+    pub kinds: RefCell<BTreeMap<String, Rc<kind_file::ScriptKindDef>>>,
     /// Every file loaded, in load order.
     pub sources: RefCell<Vec<SourceFile>>,
     /// The limits the engine was built with.
@@ -278,7 +278,7 @@ impl<V: host::Dim> ScriptWorld for crate::world::World<V> {
         options: &ScriptOptions,
     ) -> Result<crate::kind::KindId, Error> {
         let rt = Runtime::new(options, path.parent());
-        kind::load_into(&rt, self, &path.display().to_string())
+        kind_file::load_into(&rt, self, &path.display().to_string())
     }
 }
 
@@ -294,7 +294,7 @@ pub fn check(paths: &[PathBuf], options: &ScriptOptions) -> Result<Vec<String>, 
         } else {
             let dir = path.parent().map(Path::to_path_buf);
             let rt = Runtime::new(options, dir.as_deref());
-            let def = kind::load_def(&rt, &path.display().to_string())?;
+            let def = kind_file::load_def(&rt, &path.display().to_string())?;
             let hooks: Vec<&str> = def.hook_names().collect();
             report.push(format!(
                 "{}: kind '{}' ok (hooks: {})",

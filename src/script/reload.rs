@@ -6,7 +6,7 @@
 //! A text that does not compile or declare changes nothing.
 
 use super::host::Dim;
-use super::kind::{build, load_into, ScriptKind, ScriptKindDef};
+use super::kind_file::{build, load_into, ScriptKind, ScriptKindDef};
 use super::Runtime;
 use crate::error::{Error, ScriptError};
 use crate::world::World;

@@ -12,7 +12,11 @@ use std::rc::Rc;
 
 /// True when `a` and `b` collided in the last step, either calling.
 fn collided(world: &AnyWorld, a: CritterRef, b: CritterRef) -> bool {
-    fn hit<V>(events: &[crate::context::CollisionEvent<V>], a: CritterRef, b: CritterRef) -> bool {
+    fn hit<V>(
+        events: &[crate::step::events::CollisionEvent<V>],
+        a: CritterRef,
+        b: CritterRef,
+    ) -> bool {
         events
             .iter()
             .any(|e| (e.caller == a.0 && e.arg == b.0) || (e.caller == b.0 && e.arg == a.0))

@@ -4,8 +4,8 @@ use crate::border::Border;
 use crate::broad_phase::BroadPhaseMode;
 use crate::error::Error;
 use crate::method::Method;
+use crate::vector::fmt_vec;
 use crate::vector::Vector;
-use crate::world::fmt_vec;
 
 /// The settings a world is made with.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,10 +1,10 @@
 //! Where the critters are stored: laid out along the grid's rows, so that critters near each
 //! other in space are near each other in memory, as the broad phase walks them.
 
-use super::state::State;
 use crate::border::Topology;
 use crate::broad_phase::BroadPhase;
 use crate::critter::Critter;
+use crate::step::state::State;
 use crate::vector::Vector;
 
 /// When the world lays its critters out in memory (see [`Locality`]), by default: every 200

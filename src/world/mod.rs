@@ -15,43 +15,37 @@
 //! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
 
-pub(crate) mod births;
 mod build;
 mod config;
 mod diagnostics;
 mod layout;
-pub(crate) mod neighbours;
+mod queries;
 mod restore;
-pub(crate) mod stages;
-pub(crate) mod state;
 mod state_hash;
-pub(crate) mod stats;
 mod step;
 #[cfg(test)]
-mod tests;
-pub(crate) mod touch;
+pub(crate) mod tests;
 
-pub(crate) use build::{check_radius_in_box, OnOverlap, Placed};
+pub use crate::step::stats::StepStats;
 pub use config::WorldConfig;
 pub use diagnostics::Diagnostics;
 pub use layout::{Locality, LOCALITY};
-pub use stats::StepStats;
 
 use crate::border::Topology;
-use crate::context::StepEvents;
 use crate::critter::{Critter, CritterId, Props};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::kind::KindSet;
 use crate::method::auto::Why;
-use crate::method::state::MethodState;
+use crate::method::method_state::MethodState;
 use crate::method::Method;
 use crate::rng::Rng;
 use crate::rules::RuleCache;
+use crate::step::events::StepEvents;
+use crate::step::pairs::Pairs;
+use crate::step::state::State;
 use crate::vector::Vector;
 use layout::Layout;
-use stages::pairs::Pairs;
-use state::State;
 use std::collections::BTreeMap;
 
 /// A world of critters in 2D (`World<DVec2>`) or 3D (`World<DVec3>`).
@@ -313,10 +307,4 @@ impl<V: Vector> World<V> {
             .map(|c| c.id)
             .collect())
     }
-}
-
-/// "(1, 2.5)" or "(1, 2.5, 0)".
-pub fn fmt_vec<V: Vector>(v: V) -> String {
-    let parts: Vec<String> = (0..V::DIM).map(|a| format!("{}", v.get(a))).collect();
-    format!("({})", parts.join(", "))
 }

@@ -1,15 +1,15 @@
 //! A world put back in a recorded state: its critters and generator, and what the methods
 //! carry from step to step (the solve's impulses, the counts of quiet steps towards sleep).
 
-use super::stages::pairs::Pairs;
 use super::World;
-use crate::context::Pending;
 use crate::critter::{Critter, CritterId};
 use crate::critter_set::CritterSet;
 use crate::kind::WALL;
 use crate::method::sleep::SLEEP_STEPS;
-use crate::pairs::{pair_key, unpair_key};
+use crate::pair_order::{pair_key, unpair_key};
 use crate::rng::Rng;
+use crate::step::pairs::Pairs;
+use crate::step::pending::Pending;
 use crate::vector::Vector;
 
 impl<V: Vector> World<V> {

@@ -1,9 +1,10 @@
 //! The step, as a recipe of named stages (see the module docs of [`crate::world`]).
 
-use super::stages::{lifecycle, update};
-use super::stats::{timed, StepStats};
-use super::{touch, World};
+use super::World;
 use crate::error::Error;
+use crate::step::stats::{timed, StepStats};
+use crate::step::touch;
+use crate::step::update;
 use crate::vector::Vector;
 
 impl<V: Vector> World<V> {
@@ -35,9 +36,7 @@ impl<V: Vector> World<V> {
             // Timed with the lifecycle: both send what the step's contacts and deaths started.
             timed(&mut stats.lifecycle, || touch::run(&mut self.state))?;
         }
-        timed(&mut stats.lifecycle, || {
-            lifecycle::run(&mut self.state, &mut self.methods)
-        })?;
+        timed(&mut stats.lifecycle, || self.lifecycle())?;
 
         self.finish_step(stats);
         Ok(())

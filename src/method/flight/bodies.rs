@@ -2,8 +2,8 @@
 //! are large and scattered), and each critter's own clock.
 
 use super::Scratch;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// What predictions read about a critter; refreshed whenever the flight or a hook changes the
 /// critter. 48 bytes in 2D, one cache line in 3D: what a pair test reads and nothing else.

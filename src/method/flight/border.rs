@@ -6,8 +6,8 @@ use super::events::{offer, EventKind};
 use super::{Scratch, BORDER_PARTNER};
 use crate::border::Border;
 use crate::method::toi::smallest_nonneg_root;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// Offers the border hits of disk `a` (`motion`: at `t`).
 pub(super) fn predict_border<V: Vector>(

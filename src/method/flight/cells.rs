@@ -7,8 +7,8 @@ use super::events::{offer, EventKind};
 use super::shells::relist;
 use super::Scratch;
 use crate::method::toi::smallest_nonneg_root;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// Lists of critters stored flat, in stripes: list `k` owns `stride` entries from
 /// `base + k * stride`, its length first, then its members. The stride is a power of two and

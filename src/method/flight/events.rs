@@ -3,8 +3,8 @@
 
 use super::Scratch;
 use crate::method::queue::Owned;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 use std::cmp::Ordering;
 
 /// What an event is. An enum, not a plain byte, so that `Option<Event>` needs no tag of its own

@@ -8,9 +8,9 @@ use super::predict::predict;
 use super::{fly, fly_new, FlightEnd, Scratch};
 use crate::critter::Critter;
 use crate::error::Error;
+use crate::step::state::State;
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::state::State;
-use crate::world::stats::StepStats;
 
 /// A kept flight is set up anew at every step whose number is a multiple of this, so that a
 /// replay restored at such a step flies as the recorded run did.

@@ -59,11 +59,11 @@ mod tests;
 
 use crate::error::Error;
 use crate::method::queue::Queue;
-use crate::pairs::pair_key;
+use crate::pair_order::pair_key;
 use crate::rules::roles_order;
+use crate::step::state::{at_step, State};
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::state::{at_step, State};
-use crate::world::stats::StepStats;
 use bodies::{advance, refresh_body, Body, Status};
 use border::bounce_border;
 use cells::{cross_cell, relocate, StripedLists};
@@ -476,7 +476,7 @@ fn fly<V: Vector>(
                 }
                 if let (Some(x), Some(y)) = (w.critters.slot(a), w.critters.slot(b)) {
                     if x.alive && y.alive {
-                        if let Some(c) = crate::response::contact_between(&w.topo, x, y) {
+                        if let Some(c) = crate::default_response::contact_between(&w.topo, x, y) {
                             if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {
                                 sc.stuck.insert(pair_key(a, b));
                             }

@@ -18,10 +18,10 @@ use crate::contact::contact_wall_ball;
 use crate::critter::Shape;
 use crate::error::Error;
 use crate::method::toi::{surely_no_toi_by, toi_ball_ball, toi_ball_ball_by, toi_wall_ball};
-use crate::pairs::pair_key;
+use crate::pair_order::pair_key;
 use crate::rules::PairRule;
+use crate::step::state::{at_step, State};
 use crate::vector::Vector;
-use crate::world::state::{at_step, State};
 
 /// Conservative-advancement iterations before a curved prediction is continued by a recheck
 /// event (so that one grazing pair cannot hold up the flight).

@@ -12,8 +12,8 @@ use super::{
 use crate::border::Border;
 use crate::contact::contact_wall_ball;
 use crate::critter::{Shape, CLASS_UNSET};
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// Sets up a new flight of `life` steps whose predictions look to `horizon`.
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together

@@ -7,8 +7,8 @@ use super::bodies::Motion;
 use super::cells::{cell_of, cells_around, move_cell};
 use super::{Scratch, ROUNDING_MARGIN};
 use crate::border::Topology;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// A shell's centre and its critter's radius (the body's, kept equal by `refresh_body`; NaN for
 /// walls and the dead): 32 bytes in 3D, aligned so that one is never split between two cache

@@ -6,8 +6,8 @@ use super::values::{from_prop, from_svec, num_or, to_prop, to_svec};
 use super::{error, fail, fail_hint, lib_err, Res};
 use crate::critter::{CritterId, PropValue};
 use crate::script::host::{with_env, Host};
+use crate::step::spawn::check_radius_in_box;
 use crate::vector::Vector;
-use crate::world::check_radius_in_box;
 use glam::DVec3;
 use rhai::{Dynamic, Engine, EvalAltResult, INT};
 use std::rc::Rc;
@@ -111,7 +111,7 @@ fn set_vec<V: Vector>(slot: &mut V, v: DVec3, what: &str) -> Res<()> {
     if !v.is_finite() {
         return fail(format!(
             "{what} = {}: every component must be a finite number",
-            crate::world::fmt_vec(from_svec::<V>(v))
+            crate::vector::fmt_vec(from_svec::<V>(v))
         ));
     }
     *slot = from_svec(v);
@@ -387,7 +387,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
             let a = a.0;
             let hit = with_env!(h, env => env.collide_default(a, b.0).or_else(fail))?;
             // A collide hook's contact reads the impulse of its last default response.
-            crate::script::kind::note_default(&h, a, b.0, hit);
+            crate::script::kind_file::note_default(&h, a, b.0, hit);
             Ok(hit.is_some())
         },
     );

@@ -3,12 +3,12 @@
 
 use super::values::to_svec;
 use super::{fail, num_or, Res};
-use crate::context::HookContact;
 use crate::critter::CritterId;
 use crate::script::api::CritterRef;
 use crate::script::env::Env;
 use crate::script::host::{with_env, Host};
-use crate::script::kind::{parent_collide, parent_collides_with, parent_plain};
+use crate::script::kind_file::{parent_collide, parent_collides_with, parent_plain};
+use crate::step::access::HookContact;
 use crate::vector::Vector;
 use glam::DVec3;
 use rhai::{Dynamic, Engine};

@@ -3,7 +3,7 @@
 
 use super::{fail, Res};
 use crate::script::host::Host;
-use crate::script::kind::KindDecl;
+use crate::script::kind_file::KindDecl;
 use rhai::{Dynamic, Engine, Map};
 use std::rc::Rc;
 

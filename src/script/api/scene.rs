@@ -11,7 +11,7 @@ use crate::border::Border;
 use crate::scenes::{AnyWorld, Scene};
 use crate::script::env::Env;
 use crate::script::host::{with_env, Host};
-use crate::script::kind::load_into;
+use crate::script::kind_file::load_into;
 use crate::vector::Vector;
 use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
 use crate::world::{World, WorldConfig};

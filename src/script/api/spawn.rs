@@ -8,14 +8,15 @@
 
 use super::values::{from_svec, num_or, to_prop, vec_of};
 use super::{error, fail, CritterRef, Res, HINT_MARK};
-use crate::context::SpawnOrigin;
 use crate::critter::CritterSpec;
 use crate::kind::KindId;
 use crate::script::env::Env;
 use crate::script::host::{with_env, Host};
-use crate::script::kind::load_into;
+use crate::script::kind_file::load_into;
+use crate::step::pending::OnOverlap;
+use crate::step::pending::SpawnOrigin;
+use crate::step::spawn::Placed;
 use crate::vector::Vector;
-use crate::world::{OnOverlap, Placed};
 use rhai::{Dynamic, Map};
 use std::rc::Rc;
 

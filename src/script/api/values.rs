@@ -2,8 +2,8 @@
 
 use super::{fail, CritterRef, Res};
 use crate::critter::{PropValue, Props};
+use crate::vector::fmt_vec;
 use crate::vector::Vector;
-use crate::world::fmt_vec;
 use glam::{DVec2, DVec3};
 use rhai::{Array, Dynamic, ImmutableString, Map, INT};
 

@@ -4,7 +4,7 @@
 //! which checks that no pointer into the world outlives the borrow it came from.
 
 use crate::scenes::Scene;
-use crate::script::kind::define;
+use crate::script::kind_file::define;
 use crate::script::{Runtime, ScriptOptions};
 use rhai::{Dynamic, Scope, INT};
 use std::rc::Rc;

@@ -5,8 +5,8 @@ use super::pairs::{ChunkCheck, MoveCheck, MoveReport};
 use crate::critter::Critter;
 use crate::parallel::{INPUT_CHUNK, PARALLEL_MIN};
 use crate::prefetch::prefetch;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// How many slots ahead the move asks for the next critters to be loaded: the move streams
 /// through every record and would otherwise wait on each one.

@@ -3,17 +3,23 @@
 //! queued are added. A death asked for by those hooks is handled in the same way, in a further
 //! round, so every dying critter is seen once.
 
-use crate::critter::CritterId;
+use super::spawn::Placed;
+use super::state::State;
+use crate::border::Topology;
+use crate::critter::{Critter, CritterId};
 use crate::error::Error;
-use crate::method::state::MethodState;
 use crate::vector::Vector;
-use crate::world::build::Placed;
-use crate::world::state::State;
 
-/// Removes the step's dead and adds its queued spawns.
+/// The critters a lifecycle removed, as (slot, position, radius), for what watches removals (the
+/// sleepers that rested on them wake).
+pub(crate) type Gone<V> = [(usize, V, f64)];
+
+/// Removes the step's dead and adds its queued spawns. With `watch`, the removed are told to
+/// `removed` (with the box and the slots after the removals), before the spawns are added.
 pub(crate) fn run<V: Vector>(
     state: &mut State<V>,
-    methods: &mut MethodState<V>,
+    watch: bool,
+    removed: impl FnOnce(&Topology<V>, &Gone<V>, &[Option<Critter<V>>]),
 ) -> Result<(), Error> {
     let mut gone = Vec::new();
     loop {
@@ -22,10 +28,10 @@ pub(crate) fn run<V: Vector>(
             break;
         }
         before_removal(state, &deaths)?;
-        remove(state, methods, deaths, &mut gone);
+        remove(state, watch, deaths, &mut gone);
     }
     if !gone.is_empty() {
-        methods.removed(&state.topo, &gone, state.critters.slot_slice());
+        removed(&state.topo, &gone, state.critters.slot_slice());
     }
     for p in std::mem::take(&mut state.pending.spawns) {
         match state.spawn_placed(p.spec, p.on_overlap) {
@@ -62,11 +68,10 @@ pub(crate) fn before_removal<V: Vector>(
     Ok(())
 }
 
-/// Removes the critters `deaths`; what rested on them is noted in `gone` when the method
-/// watches removals.
+/// Removes the critters `deaths`; with `watch`, each is noted in `gone`.
 fn remove<V: Vector>(
     state: &mut State<V>,
-    methods: &MethodState<V>,
+    watch: bool,
     deaths: Vec<CritterId>,
     gone: &mut Vec<(usize, V, f64)>,
 ) {
@@ -77,7 +82,7 @@ fn remove<V: Vector>(
             if c.is_wall() {
                 state.walls.retain(|&w| w != id);
             }
-            if methods.watches_removals() {
+            if watch {
                 gone.push((slot as usize, c.pos, c.radius));
             }
         }

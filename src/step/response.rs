@@ -5,8 +5,8 @@
 use super::pairs::Pairs;
 use crate::error::Error;
 use crate::prefetch::prefetch;
+use crate::step::state::State;
 use crate::vector::Vector;
-use crate::world::state::State;
 
 /// How many pairs ahead the response asks for the critters of the next pairs to be loaded.
 const CONTACTS_AHEAD: usize = 8;

@@ -14,12 +14,12 @@ use crate::broad_phase::{BroadObject, BroadPhase, BroadPhaseMode, Escapes, Objec
 use crate::critter::{Critter, Shape, CLASS_UNSET};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
-use crate::pairs::{pair_key, sort_pairs, RADIX_MIN};
+use crate::pair_order::{pair_key, sort_pairs, RADIX_MIN};
 use crate::parallel::{INPUT_CHUNK, PARALLEL_PAIRS};
 use crate::prefetch::prefetch;
 use crate::rules::{roles_of, roles_slots, RuleCache};
+use crate::step::state::{at_step, State};
 use crate::vector::Vector;
-use crate::world::state::{at_step, State};
 
 /// How many pairs ahead the fused rules and narrow phase ask for the critters of the next pairs
 /// to be loaded (they are scattered over memory, and the loads overlap).

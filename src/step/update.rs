@@ -1,10 +1,10 @@
 //! The update stage: each live critter whose kind has an `update` hook runs it, in id order
 //! wherever the critters are stored.
 
-use crate::context::UpdateCtx;
 use crate::error::Error;
+use crate::step::access::UpdateCtx;
+use crate::step::state::{hook_error, State};
 use crate::vector::Vector;
-use crate::world::state::{hook_error, State};
 
 /// Runs the `update` hooks of the step.
 pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {

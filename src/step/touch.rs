@@ -13,79 +13,12 @@
 //! (pairs in id order), each to the lower id's kind and then to the higher's, each from its own
 //! side. A critter that dies ends its spells in the lifecycle, before its `on_death`.
 
+use super::access::{CollideCtx, HookContact};
+use super::spells::{ordered, Pair};
 use super::state::{hook_error, State};
-use crate::context::{CollideCtx, HookContact};
 use crate::critter::CritterId;
 use crate::error::Error;
 use crate::vector::Vector;
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
-/// A pair, lower id first.
-type Pair = (CritterId, CritterId);
-
-/// The spells going on, and the pairs touching in the current step.
-#[derive(Clone, Debug)]
-pub(crate) struct Spells<V> {
-    /// Pairs whose spell went on at the end of the last step, ascending.
-    open: Vec<Pair>,
-    /// Pairs touching in this step so far; for a pair not in `open`, its contact when it first
-    /// touched, seen from the lower id. Hashed, as every `collide` call asks it; the touch
-    /// stage sorts it.
-    now: HashMap<Pair, Option<HookContact<V>>, BuildHasherDefault<PairHasher>>,
-}
-
-/// A multiply-rotate hash of a pair's words: ids are small integers, which need no defence
-/// against chosen collisions, and the std SipHash would cost more than the map's other work.
-#[derive(Default)]
-struct PairHasher(u64);
-
-impl Hasher for PairHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_u32(&mut self, word: u32) {
-        self.write_u64(u64::from(word));
-    }
-    fn write_u64(&mut self, word: u64) {
-        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-}
-
-impl<V> Default for Spells<V> {
-    fn default() -> Self {
-        Spells {
-            open: Vec::new(),
-            now: HashMap::default(),
-        }
-    }
-}
-
-impl<V> Spells<V> {
-    /// True while `a` and `b` are in a spell that went on at the end of the last step.
-    pub(crate) fn is_open(&self, a: CritterId, b: CritterId) -> bool {
-        self.open.binary_search(&ordered(a, b)).is_ok()
-    }
-
-    /// Forgets every spell (a world put back in a recorded state).
-    pub(crate) fn clear(&mut self) {
-        self.open.clear();
-        self.now.clear();
-    }
-}
-
-fn ordered(a: CritterId, b: CritterId) -> Pair {
-    if a <= b {
-        (a, b)
-    } else {
-        (b, a)
-    }
-}
 
 impl<V: Vector> State<V> {
     /// Notes that the critters in slots `caller` and `arg` touch in this step; returns true when
@@ -206,7 +139,7 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
             else {
                 continue; // removed: its spells were ended then
             };
-            if !a.alive || !b.alive || crate::response::touches(&state.topo, a, b) {
+            if !a.alive || !b.alive || crate::default_response::touches(&state.topo, a, b) {
                 // The dying end their spells in the lifecycle; a pair the method did not
                 // report (sleepers) but that still touches goes on.
                 kept.push(pair);

@@ -2,16 +2,19 @@
 //! rules, the world box, the generator, and the step's events and queued changes. Each stage
 //! and method is handed this, and the parts of its own it needs, explicitly.
 
+use super::access::{Access, CollideCtx, UpdateCtx};
+use super::births::Births;
+use super::events::{CollisionEvent, StepEvents};
+use super::pending::Pending;
 use crate::border::Topology;
-use crate::context::{Access, CollideCtx, CollisionEvent, Pending, StepEvents, UpdateCtx};
 use crate::critter::{CritterId, Props};
 use crate::critter_set::CritterSet;
 use crate::error::Error;
 use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
 use crate::rules::{roles_of, roles_slots, RuleCache};
+use crate::step::neighbours::{Neighbours, Scope};
 use crate::vector::Vector;
-use crate::world::neighbours::Neighbours;
 
 /// The state a step works on (see the module docs).
 pub(crate) struct State<V: Vector> {
@@ -39,9 +42,9 @@ pub(crate) struct State<V: Vector> {
     /// The grid neighbour queries use, built on the first one (see `neighbours`).
     pub(crate) neighbours: Neighbours<V>,
     /// The step each critter was spawned at (for `age`).
-    pub(crate) births: super::births::Births,
+    pub(crate) births: Births,
     /// The touching spells, kept when some kind tracks them.
-    pub(crate) touch: super::touch::Spells<V>,
+    pub(crate) touch: super::spells::Spells<V>,
 }
 
 impl<V: Vector> State<V> {
@@ -129,7 +132,10 @@ impl<V: Vector> State<V> {
         let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
             return Ok(None);
         };
-        if !a.alive || !b.alive || crate::response::contact_between(&self.topo, a, b).is_none() {
+        if !a.alive
+            || !b.alive
+            || crate::default_response::contact_between(&self.topo, a, b).is_none()
+        {
             return Ok(None);
         }
         if !ask {
@@ -177,7 +183,7 @@ impl<V: Vector> State<V> {
             return;
         };
         let d = self.topo.delta(c.pos, a.pos);
-        let (normal, point) = match crate::response::contact_between(&self.topo, c, a) {
+        let (normal, point) = match crate::default_response::contact_between(&self.topo, c, a) {
             Some(contact) => (contact.normal, c.pos + contact.point),
             None => {
                 let len = d.length();
@@ -192,6 +198,18 @@ impl<V: Vector> State<V> {
             normal,
             impulse: 0.0,
         });
+    }
+}
+
+impl<V: Vector> State<V> {
+    /// The neighbour grid, and the critters it files.
+    pub(crate) fn scope(&mut self) -> (&mut Neighbours<V>, Scope<'_, V>) {
+        let at = Scope {
+            critters: &self.critters,
+            kinds: &self.kinds,
+            topo: &self.topo,
+        };
+        (&mut self.neighbours, at)
     }
 }
 

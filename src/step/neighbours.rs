@@ -20,8 +20,6 @@ use crate::critter_set::CritterSet;
 use crate::kind::{KindId, KindSet};
 use crate::tolerance::ROUNDING_MARGIN;
 use crate::vector::Vector;
-use crate::world::state::State;
-use crate::world::World;
 
 /// No item (end of a cell's list, or an id index with no item).
 const NONE: u32 = u32::MAX;
@@ -541,57 +539,6 @@ impl<V: Vector> Grid<V> {
 fn passes<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
     debug_assert!(filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k)));
     filter.exclude != Some(item.id) && at.critters.get(item.id).is_some_and(|c| c.alive)
-}
-
-impl<V: Vector> State<V> {
-    fn scope(&mut self) -> (&mut Neighbours<V>, Scope<'_, V>) {
-        let at = Scope {
-            critters: &self.critters,
-            kinds: &self.kinds,
-            topo: &self.topo,
-        };
-        (&mut self.neighbours, at)
-    }
-}
-
-impl<V: Vector> World<V> {
-    /// Live critters other than walls whose centres lie within `r` of `centre` (through the
-    /// border when it wraps), of `kind` or a kind extending it when given, leaving out
-    /// `exclude`, in id order. Looks only at the grid cells the ball overlaps.
-    pub fn nearby(
-        &mut self,
-        centre: V,
-        r: f64,
-        kind: Option<KindId>,
-        exclude: Option<CritterId>,
-    ) -> Vec<CritterId> {
-        let (grid, at) = self.state.scope();
-        grid.nearby(at, centre, r, Filter { kind, exclude })
-    }
-
-    /// The live critter other than walls nearest to `centre`, of `kind` (or a kind extending
-    /// it) when given, leaving out `exclude`; ties go to the lower id.
-    pub fn nearest(
-        &mut self,
-        centre: V,
-        kind: Option<KindId>,
-        exclude: Option<CritterId>,
-    ) -> Option<CritterId> {
-        let (grid, at) = self.state.scope();
-        grid.nearest(at, centre, Filter { kind, exclude })
-    }
-
-    /// True when a disk of radius `r` at `p` would overlap a critter other than a wall (live
-    /// or dying): `w.scatter`'s test, not `|delta| > r + radius`, asked only of nearby critters.
-    pub(crate) fn overlaps_critter(&mut self, p: V, r: f64) -> bool {
-        let (grid, at) = self.state.scope();
-        let topo = at.topo;
-        grid.any_overlapping(at, p, r, |c| {
-            // As `!(a > b)`, so a NaN radius overlaps everything, as the scan it replaces did.
-            topo.delta(c.pos, p).length().partial_cmp(&(c.radius() + r))
-                != Some(std::cmp::Ordering::Greater)
-        })
-    }
 }
 
 #[cfg(test)]

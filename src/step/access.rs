@@ -1,57 +1,18 @@
 //! What a kind's hooks see: the critters involved, the rest of the world read and write, and
 //! queues for structural changes (deaths, spawns) that take effect after the step.
 
+use super::births::Births;
+use super::events::{CollisionEvent, StepEvents};
+use super::neighbours::{Filter, Neighbours, Scope};
+use super::pending::{OnOverlap, Pending, PendingSpawn, SpawnOrigin};
 use crate::border::Topology;
 use crate::critter::{Critter, CritterId, CritterSpec, Props};
 use crate::critter_set::CritterSet;
-use crate::error::{Error, ScriptError};
+use crate::default_response::{self, Hit};
 use crate::kind::{KindId, KindSet};
-use crate::response::{self, Hit};
 use crate::rng::Rng;
 use crate::vector::Vector;
-use crate::world::neighbours::{Filter, Neighbours, Scope};
-use crate::world::OnOverlap;
 use std::ops::{Deref, DerefMut};
-
-/// A collision that happened in a step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CollisionEvent<V> {
-    /// The critter whose `collide` ran.
-    pub caller: CritterId,
-    /// The other one.
-    pub arg: CritterId,
-    /// Contact point.
-    pub point: V,
-    /// Unit normal from caller to arg.
-    pub normal: V,
-    /// Impulse given to the arg along the normal (0 when they were already separating).
-    pub impulse: f64,
-}
-
-/// Everything that happened in the last step, for summaries and recordings.
-#[derive(Clone, Debug, Default)]
-pub struct StepEvents<V> {
-    /// Default collisions, in the order they were resolved.
-    pub collisions: Vec<CollisionEvent<V>>,
-    /// Critters that died (removed at the end of the step).
-    pub deaths: Vec<CritterId>,
-    /// Critters spawned.
-    pub spawns: Vec<CritterId>,
-    /// Damage taken: (critter, amount).
-    pub damages: Vec<(CritterId, f64)>,
-    /// Lines logged by hooks.
-    pub log: Vec<String>,
-}
-
-impl<V> StepEvents<V> {
-    pub(crate) fn clear(&mut self) {
-        self.collisions.clear();
-        self.deaths.clear();
-        self.spawns.clear();
-        self.damages.clear();
-        self.log.clear();
-    }
-}
 
 /// The contact of a pair as a hook sees it (`collide`'s third argument, `touch_begin`'s).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,7 +33,7 @@ impl<V: Vector> HookContact<V> {
     /// The contact of `me` with `other` where they are now; when they do not touch (a hook moved
     /// one), the normal along the line of centres and depth 0.
     pub fn between(topo: &Topology<V>, me: &Critter<V>, other: &Critter<V>, first: bool) -> Self {
-        let (normal, point, depth) = match response::contact_between(topo, me, other) {
+        let (normal, point, depth) = match default_response::contact_between(topo, me, other) {
             Some(c) => (c.normal, me.pos + c.point, c.depth),
             None => {
                 let d = topo.delta(me.pos, other.pos);
@@ -99,69 +60,6 @@ impl<V: Vector> HookContact<V> {
     }
 }
 
-/// Spawns waiting for the end of the step.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Pending<V: Vector> {
-    pub spawns: Vec<PendingSpawn<V>>,
-    pub deaths: Vec<CritterId>,
-}
-
-/// A spawn queued by a hook: what to add, how to place it, and where it was asked for.
-#[derive(Clone, Debug)]
-pub(crate) struct PendingSpawn<V: Vector> {
-    pub spec: CritterSpec<V>,
-    pub on_overlap: OnOverlap,
-    /// `None` for a spawn from Rust (`Access::spawn`).
-    pub origin: Option<Box<SpawnOrigin>>,
-}
-
-/// Where a queued spawn was asked for, so that its failure at the end of the step names the
-/// script's file:line:col, the hook's kind, the hook, the critter and the step.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub(crate) struct SpawnOrigin {
-    pub file: String,
-    pub line: Option<usize>,
-    pub column: Option<usize>,
-    pub kind: Option<String>,
-    pub hook: Option<String>,
-    pub critter: Option<CritterId>,
-    pub step: u64,
-}
-
-impl SpawnOrigin {
-    /// `file:line:col` of the `spawn` call.
-    pub fn place(&self) -> String {
-        match (self.line, self.column) {
-            (Some(l), Some(c)) => format!("{}:{l}:{c}", self.file),
-            (Some(l), None) => format!("{}:{l}", self.file),
-            _ => self.file.clone(),
-        }
-    }
-
-    /// `e`, the failure of the spawn asked for here, located at the `spawn` call.
-    pub fn locate(&self, e: Error) -> Error {
-        let inside_wall = matches!(e, Error::SpawnInsideWall { .. });
-        let message = match e {
-            Error::Script(s) => s.message,
-            other => other.to_string(),
-        };
-        let mut err = ScriptError::new(&self.file, format!("spawn failed: {message}"));
-        err.line = self.line;
-        err.column = self.column;
-        err.kind = self.kind.clone();
-        err.hook = self.hook.clone();
-        err.critter = self.critter;
-        err.step = Some(self.step);
-        if inside_wall {
-            err.hint = Some(
-                "add on_overlap: \"push\" (moved out) or \"skip\" (not added) to the spawn map"
-                    .into(),
-            );
-        }
-        Error::from(err)
-    }
-}
-
 /// Read-write access to the world from inside a hook.
 pub struct Access<'a, V: Vector> {
     pub(crate) critters: &'a mut CritterSet<V>,
@@ -170,7 +68,7 @@ pub struct Access<'a, V: Vector> {
     pub(crate) pending: &'a mut Pending<V>,
     pub(crate) events: &'a mut StepEvents<V>,
     pub(crate) vars: &'a mut Props,
-    pub(crate) births: &'a crate::world::births::Births,
+    pub(crate) births: &'a Births,
     pub(crate) rng: &'a mut Rng,
     pub(crate) neighbours: &'a mut Neighbours<V>,
     pub(crate) step: u64,
@@ -329,14 +227,14 @@ impl<V: Vector> Access<'_, V> {
     /// True when `a` and `b` touch now.
     pub fn touches_pair(&self, a: CritterId, b: CritterId) -> bool {
         match (self.critters.get(a), self.critters.get(b)) {
-            (Some(a), Some(b)) => response::touches(self.topo, a, b),
+            (Some(a), Some(b)) => default_response::touches(self.topo, a, b),
             _ => false,
         }
     }
     /// Pop's `contains`: `inner` lies wholly inside `outer` (disks only).
     pub fn contains_pair(&self, outer: CritterId, inner: CritterId) -> bool {
         match (self.critters.get(outer), self.critters.get(inner)) {
-            (Some(o), Some(i)) => response::contains(self.topo, o, i),
+            (Some(o), Some(i)) => default_response::contains(self.topo, o, i),
             _ => false,
         }
     }
@@ -351,7 +249,7 @@ impl<V: Vector> Access<'_, V> {
         self.neighbours.moved(caller);
         self.neighbours.moved(arg);
         let (me, other) = self.critters.pair_mut_moving(a, b);
-        let hit = response::collide_default(topo, me, other)?;
+        let hit = default_response::collide_default(topo, me, other)?;
         self.events.collisions.push(CollisionEvent {
             caller,
             arg,

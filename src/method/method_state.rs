@@ -12,10 +12,10 @@ use crate::border::Topology;
 use crate::broad_phase::BroadPhase;
 use crate::critter::Critter;
 use crate::error::Error;
+use crate::step::pairs::Pairs;
+use crate::step::state::State;
+use crate::step::stats::StepStats;
 use crate::vector::Vector;
-use crate::world::stages::pairs::Pairs;
-use crate::world::state::State;
-use crate::world::stats::StepStats;
 
 /// The method and its state between steps.
 pub(crate) struct MethodState<V: Vector> {

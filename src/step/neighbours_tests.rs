@@ -4,12 +4,12 @@
 
 use super::*;
 use crate::border::Border;
-use crate::context::UpdateCtx;
 use crate::critter::CritterSpec;
 use crate::error::Error;
 use crate::kind::{KindDefaults, KindHooks};
 use crate::rng::Rng;
-use crate::world::WorldConfig;
+use crate::step::access::UpdateCtx;
+use crate::world::{World, WorldConfig};
 use glam::{DVec2, DVec3};
 use std::cell::Cell;
 use std::rc::Rc;
