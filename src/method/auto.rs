@@ -203,27 +203,28 @@ pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 /// plus the smaller of half the thinnest wall and the smallest radius, so that two critters
 /// under half their own bounds together move less than their two radii. 0 with nothing moving.
 /// `scale` is the world's [`motion_scale`].
-pub(crate) fn tunnel_fraction<V: Vector>(world: &State<V>, scale: &MotionScale) -> f64 {
+pub(crate) fn tunnel_fraction<V: Vector>(world: &State<V>, scale: &MotionScale, dt: f64) -> f64 {
     let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
     let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
     disks
-        .map(|c| displacement(world, c) / (c.radius + spare))
+        .map(|c| displacement(world, c, dt) / (c.radius + spare))
         .fold(0.0, f64::max)
 }
 
-/// The method for the coming step and why, for `world` whose event flight is `flight` and in
-/// which `asleep` critters sleep.
+/// The method for the coming step of `dt` and why, for `world` whose event flight is `flight`
+/// and in which `asleep` critters sleep.
 pub(crate) fn choose<V: Vector>(
     world: &State<V>,
     flight: &flight::Scratch<V>,
     asleep: usize,
+    dt: f64,
 ) -> Choice {
-    let scale = motion_scale(world);
+    let scale = motion_scale(world, dt);
     let (fastest, smallest) = (scale.fastest, scale.smallest());
     let limit = SWEEP_FRACTION * smallest;
     let falling = world.gravity != V::zero();
     let tunnel = if falling {
-        tunnel_fraction(world, &scale)
+        tunnel_fraction(world, &scale, dt)
     } else {
         1.0
     };
@@ -262,7 +263,7 @@ pub(crate) fn choose<V: Vector>(
             },
         }
     } else {
-        let (fast, all) = count_fast(world, limit);
+        let (fast, all) = count_fast(world, limit, dt);
         let phi = packing(world);
         // Without gravity nothing rests: the event-driven step flies the same events without
         // the swept step's closing discrete pass, and keeps its flight for the next step.

@@ -20,6 +20,7 @@ use crate::method::auto::{MOST_SOLVE_SUBSTEPS, SOLVE_FRACTION};
 use crate::method::flight::SKIN;
 use crate::method::toi::{toi_ball_ball, toi_wall_ball};
 use crate::rules::roles_order;
+use crate::step::span::Span;
 use crate::step::state::{at_step, State};
 use crate::step::stats::StepStats;
 use crate::vector::Vector;
@@ -34,12 +35,12 @@ pub const MOST_BULLET_IMPACTS: u32 = 32;
 /// (`auto::tunnel_fraction`) is beyond what the solve's most substeps keep from tunnelling.
 /// True when bullets apply: some are found, they are at most [`BULLET_SHARE`] of the moving
 /// critters, and the border does not wrap (a bullet's flight is not carried across it).
-pub(crate) fn find<V: Vector>(state: &State<V>, out: &mut Vec<u32>) -> bool {
+pub(crate) fn find<V: Vector>(state: &State<V>, dt: f64, out: &mut Vec<u32>) -> bool {
     out.clear();
     if state.topo.wraps() {
         return false;
     }
-    let scale = crate::method::swept::motion_scale(state);
+    let scale = crate::method::swept::motion_scale(state, dt);
     let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
     let limit = SOLVE_FRACTION * f64::from(MOST_SOLVE_SUBSTEPS);
     let mut moving = 0usize;
@@ -48,7 +49,7 @@ pub(crate) fn find<V: Vector>(state: &State<V>, out: &mut Vec<u32>) -> bool {
             continue;
         };
         moving += 1;
-        let fraction = crate::method::swept::displacement(state, c) / (c.radius + spare);
+        let fraction = crate::method::swept::displacement(state, c, dt) / (c.radius + spare);
         // A NaN speed counts as a bullet: its flight finds no impact and changes nothing else.
         if fraction.is_nan() || fraction > limit {
             out.push(i as u32);
@@ -68,6 +69,7 @@ struct Hit {
 /// left it (see the module docs).
 pub(crate) fn fly<V: Vector>(
     state: &mut State<V>,
+    span: Span,
     bullets: &[u32],
     is_bullet: &[bool],
     stats: &mut StepStats,
@@ -80,7 +82,7 @@ pub(crate) fn fly<V: Vector>(
         .filter(|(_, c)| c.as_ref().is_some_and(|c| c.alive && c.is_wall()))
         .map(|(i, _)| i as u32)
         .collect();
-    let (g, dt) = (state.gravity, state.dt);
+    let (g, dt) = (state.gravity, span.dt);
     let mut near = Vec::new();
     for &b in bullets {
         match state.critters.slot_mut_moving(b) {

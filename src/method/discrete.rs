@@ -4,6 +4,7 @@
 use super::sleep::Sleep;
 use super::solve::{self, Sweeps};
 use crate::error::Error;
+use crate::step::span::Span;
 use crate::step::state::State;
 use crate::step::stats::{timed, StepStats};
 use crate::step::{motion, pairs::MoveReport, pairs::Pairs, response};
@@ -32,23 +33,21 @@ impl<V: Vector> Respond<'_, V> {
     }
 }
 
-/// Pop's step over `span` (dt, or what is left of it) without the update hooks and lifecycle:
-/// `n` times move by h = span/n, find the pairs, respond.
+/// Pop's step over `span` (the step, or what is left of it) without the update hooks and
+/// lifecycle: `span.n` times move by `span.h`, find the pairs, respond.
 pub(crate) fn substeps<V: Vector>(
     state: &mut State<V>,
     pairs: &mut Pairs<V>,
     respond: &mut Respond<'_, V>,
-    span: f64,
-    n: u32,
+    span: Span,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
-    let h = span / f64::from(n);
-    for _ in 0..n {
+    for _ in 0..span.n {
         let check = pairs.move_check();
         let moved = timed(&mut stats.moving, || {
-            motion::run(state, h, respond.still(), &check)
+            motion::run(state, span.h, respond.still(), &check)
         });
-        collide(state, pairs, respond, h, Some(moved), stats)?;
+        collide(state, pairs, respond, span, Some(moved), stats)?;
     }
     Ok(())
 }
@@ -60,21 +59,20 @@ pub(crate) fn substeps<V: Vector>(
 pub(crate) fn substeps_watching<V: Vector>(
     state: &mut State<V>,
     pairs: &mut Pairs<V>,
-    span: f64,
-    n: u32,
+    span: Span,
     stats: &mut StepStats,
 ) -> Result<bool, Error> {
-    let h = span / f64::from(n);
+    let n = span.n;
     let mut far = None;
     for _ in 0..n {
         let check = pairs.move_check();
         let (moved, found) = timed(&mut stats.moving, || {
-            motion::run_watching::<V, true>(state, h, &[], &check)
+            motion::run_watching::<V, true>(state, span.h, &[], &check)
         });
         if far.is_none() {
             far = found.and_then(|(slot, d)| state.critters.slot(slot as u32).map(|c| (c.id, d)));
         }
-        collide(state, pairs, &mut Respond::Pop, h, Some(moved), stats)?;
+        collide(state, pairs, &mut Respond::Pop, span, Some(moved), stats)?;
     }
     let Some((id, distance)) = far else {
         return Ok(false);
@@ -97,18 +95,18 @@ pub(crate) fn substeps_watching<V: Vector>(
     Ok(true)
 }
 
-/// Finds the touching pairs where the critters are now and responds, after a move of `h`
-/// (`moved` is its report, when the move ran just before).
+/// Finds the touching pairs where the critters are now and responds, after a move of
+/// `span.h` (`moved` is its report, when the move ran just before).
 pub(crate) fn collide<V: Vector>(
     state: &mut State<V>,
     pairs: &mut Pairs<V>,
     respond: &mut Respond<'_, V>,
-    h: f64,
+    span: Span,
     moved: Option<MoveReport>,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
     let ruled = timed(&mut stats.pairs, || {
-        pairs.find(state, moved, respond.still())
+        pairs.find(state, span.dt, moved, respond.still())
     })?;
     let collisions = timed(&mut stats.response, || match respond {
         Respond::Pop => response::run(state, pairs),
@@ -116,7 +114,7 @@ pub(crate) fn collide<V: Vector>(
             scratch,
             sleep,
             sweeps,
-        } => solve::respond(state, pairs, scratch, sleep, *sweeps, h),
+        } => solve::respond(state, pairs, scratch, sleep, *sweeps, span.h),
     })?;
     if let Respond::Solve { scratch, .. } = respond {
         stats.sweeps += u64::from(scratch.swept);

@@ -15,6 +15,7 @@ use super::flight;
 use crate::error::Error;
 use crate::method::swept::{finish_after_budget, motion_scale, Overrun, SWEEP_FRACTION};
 use crate::step::pairs::Pairs;
+use crate::step::span::Span;
 use crate::step::state::State;
 use crate::step::stats::StepStats;
 use crate::vector::Vector;
@@ -24,22 +25,23 @@ pub(crate) fn step<V: Vector>(
     state: &mut State<V>,
     pairs: &mut Pairs<V>,
     flight: &mut flight::Scratch<V>,
+    span: Span,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
     let clock = std::time::Instant::now();
-    let (g, dt) = (state.gravity, state.dt);
-    let stopped = flight::run(state, flight, g, dt, None, true, stats)?;
+    let g = state.gravity;
+    let stopped = flight::run(state, flight, g, span, None, true, stats)?;
     stats.response += clock.elapsed();
     if let Some(at) = stopped {
         let overrun = Overrun {
             method: "event",
             acc: g,
             at,
-            limit: SWEEP_FRACTION * motion_scale(state).smallest(),
+            limit: SWEEP_FRACTION * motion_scale(state, span.dt).smallest(),
             kicked: false,
             slow_below: None,
         };
-        finish_after_budget(state, pairs, flight, overrun, stats)?;
+        finish_after_budget(state, pairs, flight, span, overrun, stats)?;
     }
     Ok(())
 }

@@ -123,9 +123,10 @@ struct Support<'a, V: Vector> {
 ///
 /// `asleep` marks, by slot, the sleepers of `solve:n` (empty when none sleeps): they do not
 /// move in the step, so they are only tested against awake disks, and an island that holds one
-/// rests on it. Sleepers that no awake disk can reach belong to no island ([`ASLEEP`]).
-pub(crate) fn partition<V: Vector>(state: &State<V>, asleep: &[bool]) -> Islands {
-    let (g, dt) = (state.gravity.length(), state.dt);
+/// rests on it. Sleepers that no awake disk can reach belong to no island ([`ASLEEP`]). `dt`:
+/// the coming step.
+pub(crate) fn partition<V: Vector>(state: &State<V>, asleep: &[bool], dt: f64) -> Islands {
+    let g = state.gravity.length();
     let slots = state.critters.slot_slice();
     let mut disks = Vec::new();
     let mut supports = Vec::new();

@@ -13,6 +13,7 @@ use crate::broad_phase::BroadPhase;
 use crate::critter::Critter;
 use crate::error::Error;
 use crate::step::pairs::Pairs;
+use crate::step::span::Span;
 use crate::step::state::State;
 use crate::step::stats::StepStats;
 use crate::vector::Vector;
@@ -102,14 +103,14 @@ impl<V: Vector> MethodState<V> {
 
     /// The method for the coming step: the one asked for, or what `auto` chooses for `state`.
     /// (`auto` hides critters while it measures a group of islands, and shows them again.)
-    pub(crate) fn plan(&mut self, state: &mut State<V>) -> Plan {
+    pub(crate) fn plan(&mut self, state: &mut State<V>, span: Span) -> Plan {
         match self.method {
             Method::Auto => {
-                if let Some(plan) = self.plan_islands(state) {
+                if let Some(plan) = self.plan_islands(state, span) {
                     return plan;
                 }
                 self.auto_islands = None;
-                self.plan_whole(state)
+                self.plan_whole(state, span)
             }
             method => Plan {
                 method,
@@ -123,8 +124,8 @@ impl<V: Vector> MethodState<V> {
     }
 
     /// `auto`'s plan for the whole scene at once.
-    fn plan_whole(&mut self, state: &State<V>) -> Plan {
-        let choice = auto::choose(state, &self.flight, self.sleep.count());
+    fn plan_whole(&mut self, state: &State<V>, span: Span) -> Plan {
+        let choice = auto::choose(state, &self.flight, self.sleep.count(), span.dt);
         self.auto_choice = Some((choice.method, choice.why));
         Plan {
             method: choice.method,
@@ -140,7 +141,7 @@ impl<V: Vector> MethodState<V> {
     /// apply (no gravity, where nothing rests; a fixed critter that moves). A scene that needs
     /// the swept step for a few bullets is planned without them, and flies them after; one that
     /// needs it for more takes it whole.
-    fn plan_islands(&mut self, state: &mut State<V>) -> Option<Plan> {
+    fn plan_islands(&mut self, state: &mut State<V>, span: Span) -> Option<Plan> {
         if state.gravity == V::zero() {
             return None;
         }
@@ -153,18 +154,18 @@ impl<V: Vector> MethodState<V> {
         }
         // Something fast meets something thin: the swept step flies the whole scene's impacts
         // in time order already, its resting contacts included, and islands would add nothing.
-        let whole = (self.plan_whole(state), self.auto_choice);
+        let whole = (self.plan_whole(state, span), self.auto_choice);
         if whole.0.method != Method::Swept {
             self.bullets.clear();
-            return Some(self.plan_settled(state, whole));
+            return Some(self.plan_settled(state, span, whole));
         }
-        if !bullets::find(state, &mut self.bullets) {
+        if !bullets::find(state, span.dt, &mut self.bullets) {
             self.auto_islands = None;
             return Some(whole.0);
         }
         self.hide_bullets(state);
-        let whole = (self.plan_whole(state), self.auto_choice);
-        let mut plan = self.plan_settled(state, whole);
+        let whole = (self.plan_whole(state, span), self.auto_choice);
+        let mut plan = self.plan_settled(state, span, whole);
         self.show_bullets(state);
         plan.bullets = true;
         let summary = self.auto_islands.get_or_insert_with(Default::default);
@@ -197,7 +198,12 @@ impl<V: Vector> MethodState<V> {
 
     /// `auto`'s plan by islands for a scene that needs no swept step (`whole` is its plan and
     /// choice for the whole scene).
-    fn plan_settled(&mut self, state: &mut State<V>, whole: (Plan, Option<(Method, Why)>)) -> Plan {
+    fn plan_settled(
+        &mut self,
+        state: &mut State<V>,
+        span: Span,
+        whole: (Plan, Option<(Method, Why)>),
+    ) -> Plan {
         // Sleepers the update hooks moved wake now, as the step would wake them, so that the
         // partition takes only true sleepers as still.
         if self.sleep.count() > 0 {
@@ -208,12 +214,12 @@ impl<V: Vector> MethodState<V> {
             self.auto_islands = None;
             return whole.0;
         }
-        let found = islands::partition(state, self.sleep.still());
-        let plan = self.plan_found(state, &found, whole);
+        let found = islands::partition(state, self.sleep.still(), span.dt);
+        let plan = self.plan_found(state, span, &found, whole);
         if self.sleep.count() > 0 && !matches!(plan.method, Method::Solve(_)) {
             // Sleepers keep still only under a solve: otherwise they are disks like any other.
-            let found = islands::partition(state, &[]);
-            return self.plan_found(state, &found, whole);
+            let found = islands::partition(state, &[], span.dt);
+            return self.plan_found(state, span, &found, whole);
         }
         plan
     }
@@ -235,6 +241,7 @@ impl<V: Vector> MethodState<V> {
     fn plan_found(
         &mut self,
         state: &mut State<V>,
+        span: Span,
         found: &islands::Islands,
         whole: (Plan, Option<(Method, Why)>),
     ) -> Plan {
@@ -274,7 +281,7 @@ impl<V: Vector> MethodState<V> {
         mixed::groups_by_slot(found, true, &mut self.groups);
         // The Pop-step group's plan, measured on its own critters.
         mixed::hide(state, &self.groups, POP_GROUP, &mut self.hidden);
-        let mut plan = self.plan_whole(state);
+        let mut plan = self.plan_whole(state, span);
         mixed::show(state, &mut self.hidden);
         plan.mixed = true;
         self.auto_islands = Some(IslandSummary::of(found, plan.method, Method::Event, true));
@@ -293,19 +300,20 @@ impl<V: Vector> MethodState<V> {
     pub(crate) fn step(
         &mut self,
         plan: Plan,
+        span: Span,
         state: &mut State<V>,
         pairs: &mut Pairs<V>,
         stats: &mut StepStats,
     ) -> Result<(), Error> {
         if !plan.bullets {
-            return self.step_groups(plan, state, pairs, stats);
+            return self.step_groups(plan, span, state, pairs, stats);
         }
         self.hide_bullets(state);
-        let result = self.step_groups(plan, state, pairs, stats);
+        let result = self.step_groups(plan, span, state, pairs, stats);
         self.show_bullets(state);
         state.neighbours.invalidate();
         result?;
-        bullets::fly(state, &self.bullets, &self.is_bullet, stats)
+        bullets::fly(state, span, &self.bullets, &self.is_bullet, stats)
     }
 
     /// [`Self::step`] without the bullets: the whole scene under one method, or each group
@@ -313,6 +321,7 @@ impl<V: Vector> MethodState<V> {
     fn step_groups(
         &mut self,
         plan: Plan,
+        span: Span,
         state: &mut State<V>,
         pairs: &mut Pairs<V>,
         stats: &mut StepStats,
@@ -333,7 +342,7 @@ impl<V: Vector> MethodState<V> {
                 pairs.broad.forget_list();
                 self.last_groups.clear();
             }
-            return self.take(plan, state, pairs, stats);
+            return self.take(plan, span, state, pairs, stats);
         }
         let event = Plan {
             method: Method::Event,
@@ -360,7 +369,7 @@ impl<V: Vector> MethodState<V> {
             if group == EVENT_GROUP {
                 std::mem::swap(&mut pairs.broad, &mut event_broad);
             }
-            result = self.take(part, state, pairs, stats);
+            result = self.take(part, span, state, pairs, stats);
             if group == EVENT_GROUP {
                 std::mem::swap(&mut pairs.broad, &mut event_broad);
             }
@@ -380,11 +389,11 @@ impl<V: Vector> MethodState<V> {
     fn take(
         &mut self,
         plan: Plan,
+        span: Span,
         state: &mut State<V>,
         pairs: &mut Pairs<V>,
         stats: &mut StepStats,
     ) -> Result<(), Error> {
-        let dt = state.dt;
         // `auto` takes the discrete step only where nobody moves far: it is not watched.
         let watch = |m: Method| matches!(m, Method::Discrete | Method::Substep(_));
         let watching = !self.warned_tunnel && watch(self.method) && watch(plan.method);
@@ -394,17 +403,25 @@ impl<V: Vector> MethodState<V> {
                     Method::Substep(n) => n.max(1),
                     _ => 1,
                 };
-                self.warned_tunnel = discrete::substeps_watching(state, pairs, dt, n, stats)?;
+                self.warned_tunnel =
+                    discrete::substeps_watching(state, pairs, span.split(n), stats)?;
                 Ok(())
             }
             Method::Discrete | Method::Auto => {
-                discrete::substeps(state, pairs, &mut Respond::Pop, dt, 1, stats)
+                discrete::substeps(state, pairs, &mut Respond::Pop, span, stats)
             }
             Method::Substep(n) => {
-                discrete::substeps(state, pairs, &mut Respond::Pop, dt, n.max(1), stats)
+                discrete::substeps(state, pairs, &mut Respond::Pop, span.split(n.max(1)), stats)
             }
-            Method::Swept => swept::step(state, pairs, &mut self.flight, plan.per_critter, stats),
-            Method::Event => event::step(state, pairs, &mut self.flight, stats),
+            Method::Swept => swept::step(
+                state,
+                pairs,
+                &mut self.flight,
+                plan.per_critter,
+                span,
+                stats,
+            ),
+            Method::Event => event::step(state, pairs, &mut self.flight, span, stats),
             Method::Solve(_)
                 if self.rest_shortcut && self.sleep.active && self.sleep.all_still() =>
             {
@@ -421,7 +438,7 @@ impl<V: Vector> MethodState<V> {
                     sleep: &mut self.sleep,
                     sweeps: plan.sweeps.unwrap_or(Sweeps::Fixed(n)),
                 };
-                discrete::substeps(state, pairs, &mut respond, dt, plan.substeps, stats)
+                discrete::substeps(state, pairs, &mut respond, span.split(plan.substeps), stats)
             }
         }
     }

@@ -339,12 +339,11 @@ pub(crate) fn respond<V: Vector>(
     }
 
     // The move advanced each critter by its velocity before the solve; it should have gone
-    // by the solved one (x + v' dt, semi-implicit Euler with the impulses in v'): a ball
-    // resting on the floor does not sink by g dt^2 every step. `shift` held the velocities
+    // by the solved one (x + v' h, semi-implicit Euler with the impulses in v'): a ball
+    // resting on the floor does not sink by g h^2 every step. `shift` held the velocities
     // before the solve.
-    let dt = h;
     for (shift, body) in s.shift.iter_mut().zip(&s.bodies) {
-        *shift = (body.vel - *shift) * dt;
+        *shift = (body.vel - *shift) * h;
     }
 
     // 4. Positions: part of each overlap removed, velocities untouched.
@@ -427,7 +426,7 @@ pub(crate) fn respond<V: Vector>(
     // The hooks or the position sweeps may have pushed a critter across the edge.
     state.wrap_positions();
     if sleep.active {
-        let speed = crate::method::sleep::SLEEP_SPEED_STEPS * state.gravity.length() * dt;
+        let speed = crate::method::sleep::SLEEP_SPEED_STEPS * state.gravity.length() * h;
         sleep.after_solve(state.critters.slots_mut_moving(), &pairs.contacts, speed);
     }
     Ok(handled + s.rows.len())

@@ -17,6 +17,7 @@ use super::discrete::{self, Respond};
 use super::flight;
 use crate::error::Error;
 use crate::step::pairs::Pairs;
+use crate::step::span::Span;
 use crate::step::state::State;
 use crate::step::stats::StepStats;
 use crate::vector::Vector;
@@ -25,9 +26,13 @@ use crate::vector::Vector;
 /// or wall thickness.
 pub const SWEEP_FRACTION: f64 = 0.25;
 
-/// How far disk `c` moves in the coming step (the free ones after gravity's kick).
-pub(crate) fn displacement<V: Vector>(world: &State<V>, c: &crate::critter::Critter<V>) -> f64 {
-    let (g, dt) = (world.gravity, world.dt);
+/// How far disk `c` moves in the coming step of `dt` (the free ones after gravity's kick).
+pub(crate) fn displacement<V: Vector>(
+    state: &State<V>,
+    c: &crate::critter::Critter<V>,
+    dt: f64,
+) -> f64 {
+    let g = state.gravity;
     let v = if c.fixed { c.vel } else { c.vel + g * dt };
     v.length() * dt
 }
@@ -51,9 +56,9 @@ impl MotionScale {
     }
 }
 
-/// The largest displacement of a critter in the coming step, and the lengths it must be compared
-/// with (smallest disk radius, thinnest wall).
-pub(crate) fn motion_scale<V: Vector>(world: &State<V>) -> MotionScale {
+/// The largest displacement of a critter in the coming step of `dt`, and the lengths it must be
+/// compared with (smallest disk radius, thinnest wall).
+pub(crate) fn motion_scale<V: Vector>(state: &State<V>, dt: f64) -> MotionScale {
     let mut scale = MotionScale {
         fastest: 0.0,
         thinnest_wall: f64::INFINITY,
@@ -62,9 +67,9 @@ pub(crate) fn motion_scale<V: Vector>(world: &State<V>) -> MotionScale {
     // The largest squared speed, and one square root at the end: the square root and the
     // product with dt are correctly rounded and monotone, so this is bit for bit the largest
     // `displacement`, without a square root per critter.
-    let (g, dt) = (world.gravity, world.dt);
+    let g = state.gravity;
     let mut fastest_squared: f64 = 0.0;
-    for c in world.critters.iter().filter(|c| c.alive) {
+    for c in state.critters.iter().filter(|c| c.alive) {
         match c.wall() {
             Some(w) => {
                 for axis in 0..V::DIM {
@@ -82,12 +87,13 @@ pub(crate) fn motion_scale<V: Vector>(world: &State<V>) -> MotionScale {
     scale
 }
 
-/// How many live disks move more than `limit` in the coming step, and how many there are.
-pub(crate) fn count_fast<V: Vector>(world: &State<V>, limit: f64) -> (usize, usize) {
-    let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
+/// How many live disks move more than `limit` in the coming step of `dt`, and how many there
+/// are.
+pub(crate) fn count_fast<V: Vector>(state: &State<V>, limit: f64, dt: f64) -> (usize, usize) {
+    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
     let (mut fast, mut all) = (0, 0);
     for c in disks {
-        fast += usize::from(displacement(world, c) > limit);
+        fast += usize::from(displacement(state, c, dt) > limit);
         all += 1;
     }
     (fast, all)
@@ -104,13 +110,14 @@ pub(crate) fn step<V: Vector>(
     pairs: &mut Pairs<V>,
     flight: &mut flight::Scratch<V>,
     fast_only: bool,
+    span: Span,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
-    let scale = motion_scale(state);
+    let dt = span.dt;
+    let scale = motion_scale(state, dt);
     let limit = SWEEP_FRACTION * scale.smallest();
-    let dt = state.dt;
     if scale.fastest <= limit {
-        return discrete::substeps(state, pairs, &mut Respond::Pop, dt, 1, stats);
+        return discrete::substeps(state, pairs, &mut Respond::Pop, span, stats);
     }
     let clock = std::time::Instant::now();
     let dv = state.gravity * dt;
@@ -120,10 +127,10 @@ pub(crate) fn step<V: Vector>(
         }
     }
     let fast = fast_only.then_some(limit);
-    let stopped = flight::run(state, flight, V::zero(), dt, fast, false, stats)?;
+    let stopped = flight::run(state, flight, V::zero(), span, fast, false, stats)?;
     stats.response += clock.elapsed();
     match stopped {
-        None => discrete::collide(state, pairs, &mut Respond::Pop, dt, None, stats),
+        None => discrete::collide(state, pairs, &mut Respond::Pop, span, None, stats),
         Some(at) => {
             let overrun = Overrun {
                 method: "swept",
@@ -133,7 +140,7 @@ pub(crate) fn step<V: Vector>(
                 kicked: true,
                 slow_below: fast,
             };
-            finish_after_budget(state, pairs, flight, overrun, stats)
+            finish_after_budget(state, pairs, flight, span, overrun, stats)
         }
     }
 }
@@ -163,16 +170,17 @@ pub(crate) fn finish_after_budget<V: Vector>(
     state: &mut State<V>,
     pairs: &mut Pairs<V>,
     flight: &mut flight::Scratch<V>,
+    span: Span,
     o: Overrun<V>,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
     stats.budget_exceeded += 1;
-    let rest = state.dt - o.at;
+    let rest = span.dt - o.at;
     // `limit` is SWEEP_FRACTION of the smallest radius or wall thickness: the substeps cannot
     // tunnel while none moves a critter farther than that smallest length itself.
     let safe = f64::from(MOST_TAIL_SUBSTEPS) / SWEEP_FRACTION;
     if tail_substeps(state, rest, o.limit, o.kicked) <= safe {
-        return finish_in_substeps(state, pairs, rest, o.limit, o.kicked, stats);
+        return finish_in_substeps(state, pairs, span, rest, o.limit, o.kicked, stats);
     }
     if !flight.warned_budget {
         flight.warned_budget = true;
@@ -181,7 +189,7 @@ pub(crate) fn finish_after_budget<V: Vector>(
             o.method,
             flight.budget(),
             o.at,
-            state.dt
+            span.dt
         ));
     }
     flight::carry_on(
@@ -189,13 +197,13 @@ pub(crate) fn finish_after_budget<V: Vector>(
         flight,
         o.acc,
         o.at,
-        rest,
+        span.over(rest, 1),
         o.slow_below,
         o.method,
         stats,
     )?;
     if o.kicked {
-        discrete::collide(state, pairs, &mut Respond::Pop, state.dt, None, stats)?;
+        discrete::collide(state, pairs, &mut Respond::Pop, span, None, stats)?;
     }
     Ok(())
 }
@@ -224,9 +232,11 @@ fn tail_substeps<V: Vector>(world: &State<V>, rest: f64, limit: f64, kicked: boo
 /// more than `limit` (so none tunnels, as in a step that needs no sweeping), at most
 /// [`MOST_TAIL_SUBSTEPS`] of them. `kicked`: the step gave gravity's kick for the whole step up
 /// front (swept), and the rest's part of it is taken back first, since the substeps give it.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn finish_in_substeps<V: Vector>(
     world: &mut State<V>,
     pairs: &mut Pairs<V>,
+    span: Span,
     rest: f64,
     limit: f64,
     kicked: bool,
@@ -245,7 +255,13 @@ pub(crate) fn finish_in_substeps<V: Vector>(
     let n = (fastest * rest / limit)
         .ceil()
         .clamp(1.0, f64::from(MOST_TAIL_SUBSTEPS));
-    discrete::substeps(world, pairs, &mut Respond::Pop, rest, n as u32, stats)
+    discrete::substeps(
+        world,
+        pairs,
+        &mut Respond::Pop,
+        span.over(rest, n as u32),
+        stats,
+    )
 }
 
 /// The most discrete substeps that finish a swept or event step whose event budget ran out.

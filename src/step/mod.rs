@@ -19,6 +19,7 @@ pub(crate) mod neighbours;
 pub(crate) mod pairs;
 pub(crate) mod pending;
 pub(crate) mod response;
+pub(crate) mod span;
 pub(crate) mod spawn;
 pub(crate) mod spells;
 pub(crate) mod state;

@@ -85,14 +85,16 @@ impl<V: Vector> Pairs<V> {
     /// Finds the step's touching pairs where the critters are now, in response order: disk
     /// pairs by id in `contacts`, pairs with walls in `wall_pairs`. `moved` is the report of
     /// the move that ran just before, if one did; `still` marks sleepers and walls by slot
-    /// (empty when nobody sleeps). Returns how many candidates may collide.
+    /// (empty when nobody sleeps). `dt` is the step's, over which the boxes reach ahead.
+    /// Returns how many candidates may collide.
     pub(crate) fn find(
         &mut self,
         state: &mut State<V>,
+        dt: f64,
         moved: Option<MoveReport>,
         still: &[bool],
     ) -> Result<usize, Error> {
-        let narrowed = self.broad_phase(state, moved, still, true);
+        let narrowed = self.broad_phase(state, dt, moved, still, true);
         if !still.is_empty() {
             // Two sleepers, or a sleeper and a wall, stay as they were.
             let is_still = |slot: u32| still.get(slot as usize).copied().unwrap_or(false);
@@ -122,6 +124,7 @@ impl<V: Vector> Pairs<V> {
     fn broad_phase(
         &mut self,
         state: &mut State<V>,
+        dt: f64,
         moved: Option<MoveReport>,
         still: &[bool],
         fuse: bool,
@@ -150,7 +153,7 @@ impl<V: Vector> Pairs<V> {
         let objs = SlotObjects {
             slots: state.critters.slot_slice(),
             wall_pad: seen.largest_radius,
-            dt: state.dt,
+            dt,
             still,
         };
         // The move checked every slot but the live walls' against the Verlet list; the walls

@@ -1,17 +1,18 @@
 //! The update stage: each live critter whose kind has an `update` hook runs it, in id order
 //! wherever the critters are stored.
 
+use super::span::Span;
 use crate::error::Error;
 use crate::step::access::UpdateCtx;
 use crate::step::state::{hook_error, State};
 use crate::vector::Vector;
 
-/// Runs the `update` hooks of the step.
-pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
+/// Runs the `update` hooks of the step, each told the time since the last: the step `span`.
+pub(crate) fn run<V: Vector>(state: &mut State<V>, span: Span) -> Result<(), Error> {
     if !state.kinds.iter().any(|(_, k)| k.has_update) {
         return Ok(());
     }
-    let dt = state.dt;
+    let dt = span.dt;
     let step = state.step_count;
     for index in 0..state.critters.index_count() as u32 {
         let Some(slot) = state.critters.slot_of_index(index) else {

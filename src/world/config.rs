@@ -4,6 +4,7 @@ use crate::border::Border;
 use crate::broad_phase::BroadPhaseMode;
 use crate::error::Error;
 use crate::method::Method;
+use crate::step::span::check_dt;
 use crate::vector::fmt_vec;
 use crate::vector::Vector;
 
@@ -109,13 +110,6 @@ impl<V: Vector> WorldConfig<V> {
         if !self.gravity.all_finite() {
             return bad("gravity", fmt_vec(self.gravity), "must be finite");
         }
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad(
-                "dt",
-                self.dt.to_string(),
-                "must be finite and greater than zero",
-            );
-        }
-        Ok(())
+        check_dt(self.dt)
     }
 }

@@ -26,6 +26,7 @@ mod step;
 #[cfg(test)]
 pub(crate) mod tests;
 
+pub use crate::step::span::check_dt;
 pub use crate::step::stats::StepStats;
 pub use config::WorldConfig;
 pub use diagnostics::Diagnostics;
@@ -113,13 +114,7 @@ impl<V: Vector> World<V> {
     }
     /// Changes the time step.
     pub fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::InvalidWorld {
-                field: "dt",
-                value: dt.to_string(),
-                reason: "must be finite and greater than zero".into(),
-            });
-        }
+        check_dt(dt)?;
         self.state.dt = dt;
         Ok(())
     }

@@ -2,6 +2,7 @@
 
 use super::World;
 use crate::error::Error;
+use crate::step::span::Span;
 use crate::step::stats::{timed, StepStats};
 use crate::step::touch;
 use crate::step::update;
@@ -17,12 +18,13 @@ impl<V: Vector> World<V> {
         self.state.events.clear();
         self.stats = StepStats::default();
         let mut stats = StepStats::default();
+        let span = Span::of(self.state.dt);
 
         // Neighbour grids live within a stage: the engine moves critters between stages.
         self.state.neighbours.invalidate();
-        timed(&mut stats.update, || update::run(&mut self.state))?;
+        timed(&mut stats.update, || update::run(&mut self.state, span))?;
         self.state.neighbours.invalidate();
-        let plan = self.methods.plan(&mut self.state);
+        let plan = self.methods.plan(&mut self.state, span);
         // The layout is for the broad phase's sake, which rebuilds its list after one.
         let allowed = self.methods.allows_layout(&plan);
         timed(&mut stats.pairs, || {
@@ -30,7 +32,7 @@ impl<V: Vector> World<V> {
                 .lay_out(&mut self.state, &mut self.pairs.broad, allowed)
         });
         self.methods
-            .step(plan, &mut self.state, &mut self.pairs, &mut stats)?;
+            .step(plan, span, &mut self.state, &mut self.pairs, &mut stats)?;
         self.state.neighbours.invalidate();
         if self.state.kinds.tracks_touch() {
             // Timed with the lifecycle: both send what the step's contacts and deaths started.

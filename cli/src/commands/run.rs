@@ -120,10 +120,8 @@ pub fn run_once(
         return Ok(Ended::Finished);
     }
     if let Some(dt) = args.dt {
-        anyhow::ensure!(
-            dt.is_finite() && dt > 0.0,
-            "--dt {dt}: the time step must be a finite number greater than zero"
-        );
+        // Checked before the scene is built: a bad --dt is a mistyped command, not a failed set-up.
+        critterbox::world::check_dt(dt).with_context(|| format!("--dt {dt}"))?;
     }
     // Signals are watched from here on, so that one arriving while the scene is built stops
     // the run before its first step, with a finished file (a second one ends the process).

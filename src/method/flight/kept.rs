@@ -174,21 +174,21 @@ pub(super) fn steps_to_live(keep: bool, step: u64) -> u64 {
     }
 }
 
-/// A kept flight flown on for one more step of `span`, from where the last one ended.
+/// A kept flight flown on for one more step of `length`, from where the last one ended.
 pub(super) fn fly_kept<V: Vector>(
     w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
-    span: f64,
+    length: f64,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
     let start = sc.ended_at;
-    match fly(w, sc, acc, Some(start), span, 1, stats)? {
+    match fly(w, sc, acc, Some(start), length, 1, stats)? {
         FlightEnd::Done(stopped) => Ok(stopped),
         FlightEnd::Grown(t) => {
             // The rest of the step in new flights, sized for the grown critter.
             let virial = sc.virial;
-            let rest = fly_new(w, sc, acc, span - t, 1, stats);
+            let rest = fly_new(w, sc, acc, length - t, 1, stats);
             sc.virial += virial;
             sc.outgrown = true;
             Ok(rest?.map(|r| t + r))

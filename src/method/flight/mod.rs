@@ -61,6 +61,7 @@ use crate::error::Error;
 use crate::method::queue::Queue;
 use crate::pair_order::pair_key;
 use crate::rules::roles_order;
+use crate::step::span::Span;
 use crate::step::state::{at_step, State};
 use crate::step::stats::StepStats;
 use crate::vector::Vector;
@@ -185,6 +186,8 @@ pub(crate) struct Scratch<V: Vector> {
     /// How far ahead (in flight time) predictions look: the step's end, or the end of a kept
     /// flight's life.
     horizon: f64,
+    /// The step's dt (the flight may be a part of it).
+    dt: f64,
     /// A collision this soon after either critter's last is elastic (the TC model).
     tc_window: f64,
     /// Events the flight may process before it stops.
@@ -226,7 +229,8 @@ impl<V: Vector> Scratch<V> {
     }
 }
 
-/// Flies the world's critters for `t_end` under acceleration `acc` (free critters only),
+/// Flies the world's critters over `span` (one piece of `span.h`) under acceleration `acc`
+/// (free critters only),
 /// processing every event in order. Returns `None` when every event was processed, or the time
 /// the event budget ran out, where the critters were stopped (the caller finishes the step, in
 /// discrete substeps that cannot tunnel or with [`carry_on`]).
@@ -238,11 +242,13 @@ pub(crate) fn run<V: Vector>(
     w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
-    t_end: f64,
+    span: Span,
     slow_below: Option<f64>,
     keep: bool,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
+    let t_end = span.h;
+    sc.dt = span.dt;
     sc.slow_below = slow_below;
     sc.outgrown = false;
     let step = w.step_count;
@@ -279,7 +285,7 @@ pub(crate) fn run<V: Vector>(
     out
 }
 
-/// Carries a step on for `span` from where its budget ran out, in a new flight with
+/// Carries a step on over `rest` (one piece) from where its budget ran out, in a new flight with
 /// [`CARRY_ON_FACTOR`] times the budget, so that no critter moves without its events. When that
 /// runs out too, the events are endless in this step: an [`Error::EndlessEvents`] naming the
 /// step and the event it gave up on. `at`: the flight time the step had reached; `method`: the
@@ -290,14 +296,14 @@ pub(crate) fn carry_on<V: Vector>(
     sc: &mut Scratch<V>,
     acc: V,
     at: f64,
-    span: f64,
+    rest: Span,
     slow_below: Option<f64>,
     method: &'static str,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
     let before = sc.processed;
     sc.carrying_on = true;
-    let out = run(w, sc, acc, span, slow_below, false, stats);
+    let out = run(w, sc, acc, rest, slow_below, false, stats);
     sc.carrying_on = false;
     let Some(stopped) = out? else {
         return Ok(());
@@ -311,7 +317,7 @@ pub(crate) fn carry_on<V: Vector>(
         method,
         events: before + sc.processed,
         at: at + stopped,
-        dt: w.dt,
+        dt: rest.dt,
         pair,
     })
 }
@@ -374,14 +380,15 @@ enum FlightEnd {
     Grown(f64),
 }
 
-/// Flies for `span` from flight time `from` (a kept flight that `take_up_kept` took up), or
-/// sets up a new flight whose predictions look `life` steps of `span` ahead and flies it from 0.
+/// Flies for `length` from flight time `from` (a kept flight that `take_up_kept` took up), or
+/// sets up a new flight whose predictions look `life` steps of `length` ahead and flies it
+/// from 0.
 fn fly<V: Vector>(
     w: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     from: Option<f64>,
-    span: f64,
+    length: f64,
     life: u64,
     stats: &mut StepStats,
 ) -> Result<FlightEnd, Error> {
@@ -392,9 +399,9 @@ fn fly<V: Vector>(
             // A little past the life's last step's end, whatever the rounding of the steps'
             // sums of dt.
             let horizon = if life > 1 {
-                span * life as f64 * (1.0 + ROUNDING_MARGIN)
+                length * life as f64 * (1.0 + ROUNDING_MARGIN)
             } else {
-                span
+                length
             };
             setup(w, sc, acc, horizon, life);
             match sc.slow_below {
@@ -415,7 +422,7 @@ fn fly<V: Vector>(
             0.0
         }
     };
-    let t_end = start + span; // (exactly `span` for a new flight, which starts at 0)
+    let t_end = start + length; // (exactly `length` for a new flight, which starts at 0)
     let mut processed = 0u64;
     let mut stopped = None;
     let mut grown = None;

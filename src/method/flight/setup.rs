@@ -73,7 +73,7 @@ pub(super) fn setup<V: Vector>(
     sc.straight = acc.length_squared() == 0.0;
     sc.acc = if sc.straight { V::zero() } else { acc };
     sc.horizon = horizon;
-    sc.tc_window = TC_FRACTION * w.dt;
+    sc.tc_window = TC_FRACTION * sc.dt;
     sc.virial = 0.0;
     sc.predictions = 0;
     sc.pair_tests = 0;

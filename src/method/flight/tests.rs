@@ -252,6 +252,7 @@ fn who_may_meet_pair_by_pair_is_may_meet() {
         let mut sc = std::mem::take(&mut w.methods.flight);
         sc.slow_below = Some(limit);
         let dt = w.dt();
+        sc.dt = dt;
         super::setup::setup(&mut w.state, &mut sc, V::zero(), dt, 1);
         super::setup::mark_who_may_meet(&w.state, &mut sc);
         let (mut yes, mut no) = (0, 0);
@@ -293,6 +294,7 @@ fn cells_come_as_close_to_their_cap_as_a_diameter_allows() {
         .expect("the gas builds");
         let mut sc = std::mem::take(&mut w.methods.flight);
         let dt = w.dt();
+        sc.dt = dt;
         super::setup::setup(&mut w.state, &mut sc, V::zero(), dt, 1);
         let total: usize = sc.dims[..V::DIM].iter().product();
         let cap = 2 * n;

@@ -171,7 +171,7 @@ fn islands_agree_with_brute_force_on_random_scenes() {
         ];
         for (n, speed, wrap) in cases {
             let w = scatter(n, speed, seed + 1, wrap);
-            let found = partition(&w.state, &[]);
+            let found = partition(&w.state, &[], w.dt());
             let mut mine: Vec<Vec<u32>> = vec![Vec::new(); found.list.len()];
             for (slot, &i) in found.of_slot.iter().enumerate() {
                 if i != NO_ISLAND {
@@ -224,7 +224,7 @@ fn a_struck_cradle_in_mid_air_is_impacts_and_a_ball_on_the_floor_rests() {
         .expect("ball");
     w.spawn(CritterSpec::ball(DVec2::new(15.0, 15.0)).radius(0.5))
         .expect("ball");
-    let found = partition(&w.state, &[]);
+    let found = partition(&w.state, &[], w.dt());
     let regimes: Vec<(usize, Regime)> = found.list.iter().map(|i| (i.size, i.regime)).collect();
     assert_eq!(
         regimes,

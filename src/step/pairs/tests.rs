@@ -36,7 +36,8 @@ fn rules_and_narrow_phase_in_one_pass_match_them_one_after_the_other() {
         for _ in 0..30 {
             w.step().unwrap();
             let (state, p) = (&mut w.state, &mut w.pairs);
-            p.broad_phase(state, None, &[], false);
+            let dt = state.dt;
+            p.broad_phase(state, dt, None, &[], false);
             if p.candidates.len() < PARALLEL_PAIRS {
                 continue;
             }
@@ -56,7 +57,8 @@ fn rules_and_narrow_phase_in_one_pass_match_them_one_after_the_other() {
             // And with the broad phase's re-test, chunk by chunk.
             p.contacts.clear();
             p.wall_pairs.clear();
-            let Narrowed::WithRetest(ruled) = p.broad_phase(state, None, &[], true) else {
+            let dt = state.dt;
+            let Narrowed::WithRetest(ruled) = p.broad_phase(state, dt, None, &[], true) else {
                 panic!("not done with the re-test");
             };
             p.sort_contacts(&state.critters);
@@ -98,7 +100,9 @@ fn check_pairs(w: &mut World<DVec2>, what: &str) -> bool {
     };
     let rebuilds = changes(w);
     let moved = move_once(w);
-    w.pairs.broad_phase(&mut w.state, Some(moved), &[], false);
+    let dt = w.dt();
+    w.pairs
+        .broad_phase(&mut w.state, dt, Some(moved), &[], false);
     assert_fresh_pairs(w, what);
     changes(w) > rebuilds
 }
@@ -148,7 +152,9 @@ fn the_move_notes_every_slot_that_left_its_bound() {
                 assert_eq!(moved.escapes.slots, full, "n {n}, step {step}");
                 noted += full.len();
             }
-            w.pairs.broad_phase(&mut w.state, Some(moved), &[], false);
+            let dt = w.dt();
+            w.pairs
+                .broad_phase(&mut w.state, dt, Some(moved), &[], false);
             assert_fresh_pairs(&w, &format!("n {n}, step {step}"));
             repairs += w.diagnostics().list_repairs - before;
         }
