@@ -47,15 +47,15 @@ pub const AUTO_MOST_SWEEPS: u32 = 64;
 pub const SPARSE: f64 = 0.05;
 
 /// The fraction of the box the live disks cover.
-pub(crate) fn packing<V: Vector>(world: &State<V>) -> f64 {
-    let size = world.topo.size();
+pub(crate) fn packing<V: Vector>(state: &State<V>) -> f64 {
+    let size = state.topo.size();
     let volume: f64 = (0..V::DIM).map(|axis| size.get(axis)).product();
     let unit = if V::DIM == 2 {
         std::f64::consts::PI
     } else {
         4.0 / 3.0 * std::f64::consts::PI
     };
-    let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
     let covered: f64 = disks.map(|c| unit * c.radius.powi(V::DIM as i32)).sum();
     covered / volume
 }
@@ -203,28 +203,28 @@ pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 /// plus the smaller of half the thinnest wall and the smallest radius, so that two critters
 /// under half their own bounds together move less than their two radii. 0 with nothing moving.
 /// `scale` is the world's [`motion_scale`].
-pub(crate) fn tunnel_fraction<V: Vector>(world: &State<V>, scale: &MotionScale, dt: f64) -> f64 {
+pub(crate) fn tunnel_fraction<V: Vector>(state: &State<V>, scale: &MotionScale, dt: f64) -> f64 {
     let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
-    let disks = world.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
     disks
-        .map(|c| displacement(world, c, dt) / (c.radius + spare))
+        .map(|c| displacement(state, c, dt) / (c.radius + spare))
         .fold(0.0, f64::max)
 }
 
 /// The method for the coming step of `dt` and why, for `world` whose event flight is `flight`
 /// and in which `asleep` critters sleep.
 pub(crate) fn choose<V: Vector>(
-    world: &State<V>,
+    state: &State<V>,
     flight: &flight::Scratch<V>,
     asleep: usize,
     dt: f64,
 ) -> Choice {
-    let scale = motion_scale(world, dt);
+    let scale = motion_scale(state, dt);
     let (fastest, smallest) = (scale.fastest, scale.smallest());
     let limit = SWEEP_FRACTION * smallest;
-    let falling = world.gravity != V::zero();
+    let falling = state.gravity != V::zero();
     let tunnel = if falling {
-        tunnel_fraction(world, &scale, dt)
+        tunnel_fraction(state, &scale, dt)
     } else {
         1.0
     };
@@ -246,7 +246,7 @@ pub(crate) fn choose<V: Vector>(
         // Without gravity (under it the step was solved above), the event step where its flight
         // can be kept: tried again from every step where a flight is set up on schedule, so the
         // choice does not depend on anything before such a step (a replay restores there).
-        let calm = !falling && !flight.churned(world.step_count);
+        let calm = !falling && !flight.churned(state.step_count);
         Choice {
             method: if calm {
                 Method::Event
@@ -263,8 +263,8 @@ pub(crate) fn choose<V: Vector>(
             },
         }
     } else {
-        let (fast, all) = count_fast(world, limit, dt);
-        let phi = packing(world);
+        let (fast, all) = count_fast(state, limit, dt);
+        let phi = packing(state);
         // Without gravity nothing rests: the event-driven step flies the same events without
         // the swept step's closing discrete pass, and keeps its flight for the next step.
         let event = !falling;

@@ -210,10 +210,10 @@ pub(crate) fn finish_after_budget<V: Vector>(
 
 /// The discrete substeps [`finish_in_substeps`] needs so that none moves a critter more than
 /// `limit` (before it clamps them to [`MOST_TAIL_SUBSTEPS`]); NaN when a speed is not finite.
-fn tail_substeps<V: Vector>(world: &State<V>, rest: f64, limit: f64, kicked: bool) -> f64 {
-    let g = world.gravity;
+fn tail_substeps<V: Vector>(state: &State<V>, rest: f64, limit: f64, kicked: bool) -> f64 {
+    let g = state.gravity;
     let mut fastest: f64 = 0.0;
-    for c in world.critters.iter() {
+    for c in state.critters.iter() {
         if c.alive && !c.is_wall() {
             // The same arithmetic as `finish_in_substeps`, without changing the velocities.
             let v = if kicked && !c.fixed {
@@ -234,7 +234,7 @@ fn tail_substeps<V: Vector>(world: &State<V>, rest: f64, limit: f64, kicked: boo
 /// front (swept), and the rest's part of it is taken back first, since the substeps give it.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn finish_in_substeps<V: Vector>(
-    world: &mut State<V>,
+    state: &mut State<V>,
     pairs: &mut Pairs<V>,
     span: Span,
     rest: f64,
@@ -242,9 +242,9 @@ pub(crate) fn finish_in_substeps<V: Vector>(
     kicked: bool,
     stats: &mut StepStats,
 ) -> Result<(), Error> {
-    let g = world.gravity;
+    let g = state.gravity;
     let mut fastest: f64 = 0.0;
-    for c in world.critters.iter_mut_moving() {
+    for c in state.critters.iter_mut_moving() {
         if c.alive && !c.is_wall() {
             if kicked && !c.fixed {
                 c.vel -= g * rest;
@@ -256,7 +256,7 @@ pub(crate) fn finish_in_substeps<V: Vector>(
         .ceil()
         .clamp(1.0, f64::from(MOST_TAIL_SUBSTEPS));
     discrete::substeps(
-        world,
+        state,
         pairs,
         &mut Respond::Pop,
         span.over(rest, n as u32),

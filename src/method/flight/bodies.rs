@@ -45,11 +45,11 @@ pub(super) struct Motion<V> {
 
 /// Copies critter `a` into its body (after the flight or a hook changed it).
 #[inline]
-pub(super) fn refresh_body<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: u32) {
+pub(super) fn refresh_body<V: Vector>(state: &State<V>, sc: &mut Scratch<V>, a: u32) {
     // Field by field into place: a body built whole on the stack and copied is read back
     // across two of its stores (a stall on every collision).
     let (body, status) = (&mut sc.body[a as usize], &mut sc.status[a as usize]);
-    match w.critters.slot(a) {
+    match state.critters.slot(a) {
         Some(c) => {
             body.pos = c.pos;
             body.vel = c.vel;
@@ -113,7 +113,7 @@ pub(super) fn motion_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> Motion<V>
 }
 
 /// Brings critter `a` (and its body) to time `t` along its flight.
-pub(super) fn advance<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+pub(super) fn advance<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let s = sc.status[a as usize];
     if !s.alive || s.wall {
         return;
@@ -123,7 +123,7 @@ pub(super) fn advance<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32, 
     body.pos = pos;
     body.vel = vel;
     body.t = t;
-    if let Some(c) = w.critters.slot_mut_moving(a) {
+    if let Some(c) = state.critters.slot_mut_moving(a) {
         c.pos = pos;
         c.vel = vel;
     }

@@ -11,21 +11,21 @@ use crate::vector::Vector;
 
 /// Offers the border hits of disk `a` (`motion`: at `t`).
 pub(super) fn predict_border<V: Vector>(
-    w: &State<V>,
+    state: &State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
     motion: Motion<V>,
 ) {
-    if w.topo.border == Border::Wrap {
+    if state.topo.border == Border::Wrap {
         return;
     }
     let r = sc.body[a as usize].radius;
     let Motion { pos, vel, acc } = motion;
     let last = sc.last_partner[a as usize];
     for axis in 0..V::DIM {
-        let lo = w.topo.min.get(axis) + r;
-        let hi = w.topo.max.get(axis) - r;
+        let lo = state.topo.min.get(axis) + r;
+        let hi = state.topo.max.get(axis) - r;
         if lo > hi {
             continue;
         }
@@ -67,11 +67,11 @@ pub(super) fn on_bound(v: f64, a: f64) -> Option<f64> {
 
 /// Puts critter `a` on the border side `tag` (`axis * 2 + side`) and bounces it (or, on a clamp
 /// border, stops it along the axis) if it moves outward.
-pub(super) fn bounce_border<V: Vector>(w: &mut State<V>, a: u32, tag: u32) {
+pub(super) fn bounce_border<V: Vector>(state: &mut State<V>, a: u32, tag: u32) {
     let (axis, side) = ((tag / 2) as usize, tag % 2);
-    let border = w.topo.border;
-    let (lo, hi) = (w.topo.min.get(axis), w.topo.max.get(axis));
-    let c = w.critters.slot_mut_moving(a).expect("live slot");
+    let border = state.topo.border;
+    let (lo, hi) = (state.topo.min.get(axis), state.topo.max.get(axis));
+    let c = state.critters.slot_mut_moving(a).expect("live slot");
     let bound = if side == 1 {
         hi - c.radius
     } else {

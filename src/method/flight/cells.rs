@@ -123,10 +123,10 @@ pub(super) fn cell_coords(dims: &[usize; 3], k: usize) -> [i64; 3] {
 
 /// The cell of position `p`: its key and its coordinates (kept beside the key, which would
 /// take three divisions to unpack).
-pub(super) fn cell_of<V: Vector>(w: &State<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) {
+pub(super) fn cell_of<V: Vector>(state: &State<V>, sc: &Scratch<V>, p: V) -> (usize, [i64; 3]) {
     let mut c = [0i64; 3];
     for (axis, ca) in c.iter_mut().enumerate().take(V::DIM) {
-        let x = ((p.get(axis) - w.topo.min.get(axis)) / sc.cell_side[axis]).floor() as i64;
+        let x = ((p.get(axis) - state.topo.min.get(axis)) / sc.cell_side[axis]).floor() as i64;
         *ca = x.clamp(0, sc.dims[axis] as i64 - 1);
     }
     (cell_key(&sc.dims, c), c)
@@ -149,7 +149,7 @@ pub(super) fn interior_at<V: Vector>(sc: &Scratch<V>, hc: [i64; 3]) -> bool {
 /// they are wrapped or cut at the border, and with fewer than three cells along an axis they
 /// repeat); their number.
 pub(super) fn cells_around<V: Vector>(
-    w: &State<V>,
+    state: &State<V>,
     sc: &Scratch<V>,
     a: u32,
     out: &mut [usize; 27],
@@ -161,13 +161,13 @@ pub(super) fn cells_around<V: Vector>(
         }
         return sc.offsets.len();
     }
-    cells_around_cell(w, sc, sc.coord[a as usize], out)
+    cells_around_cell(state, sc, sc.coord[a as usize], out)
 }
 
 /// [`cells_around`] the cell at coordinates `hc`, by the general path (wrapped or cut at the
 /// grid's edges, each once).
 pub(super) fn cells_around_cell<V: Vector>(
-    w: &State<V>,
+    state: &State<V>,
     sc: &Scratch<V>,
     hc: [i64; 3],
     out: &mut [usize; 27],
@@ -179,7 +179,8 @@ pub(super) fn cells_around_cell<V: Vector>(
         for dy in span(1) {
             for dx in span(0) {
                 let cc = [hc[0] + dx, hc[1] + dy, hc[2] + dz];
-                if !w.topo.wraps() && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
+                if !state.topo.wraps()
+                    && (0..V::DIM).any(|ax| cc[ax] < 0 || cc[ax] >= dims[ax] as i64)
                 {
                     continue;
                 }
@@ -197,7 +198,7 @@ pub(super) fn cells_around_cell<V: Vector>(
 /// Offers `a`'s next crossing out of its cell, from time `t` (the general formulas: curved or
 /// straight flights).
 #[allow(clippy::needless_range_loop)]
-pub(super) fn predict_crossing<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
+pub(super) fn predict_crossing<V: Vector>(state: &State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let Motion { pos, vel, acc } = motion_at(sc, a, t);
     let cc = sc.coord[a as usize];
     let mut best = (f64::INFINITY, 0u32);
@@ -206,7 +207,7 @@ pub(super) fn predict_crossing<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: 
         if n == 1 {
             continue;
         }
-        let lo = w.topo.min.get(axis) + cc[axis] as f64 * sc.cell_side[axis];
+        let lo = state.topo.min.get(axis) + cc[axis] as f64 * sc.cell_side[axis];
         let hi = lo + sc.cell_side[axis];
         let (x, vx, ax) = (pos.get(axis), vel.get(axis), acc.get(axis));
         for dir in [0u32, 1] {
@@ -215,7 +216,7 @@ pub(super) fn predict_crossing<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: 
             } else {
                 cc[axis] == 0
             };
-            if at_edge && !w.topo.wraps() {
+            if at_edge && !state.topo.wraps() {
                 continue;
             }
             let outward = if dir == 1 { 1.0 } else { -1.0 };
@@ -244,7 +245,7 @@ pub(super) fn predict_crossing<V: Vector>(w: &State<V>, sc: &mut Scratch<V>, a: 
 #[inline]
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 pub(super) fn predict_crossing_straight<V: Vector>(
-    w: &State<V>,
+    state: &State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
@@ -252,7 +253,7 @@ pub(super) fn predict_crossing_straight<V: Vector>(
 ) {
     let Motion { pos, vel, .. } = motion;
     let cc = sc.coord[a as usize];
-    let wraps = w.topo.wraps();
+    let wraps = state.topo.wraps();
     let mut best = (f64::INFINITY, 0u32);
     for axis in 0..V::DIM {
         let n = sc.dims[axis] as i64;
@@ -264,7 +265,7 @@ pub(super) fn predict_crossing_straight<V: Vector>(
         if !wraps && (if up { cc[axis] == n - 1 } else { cc[axis] == 0 }) {
             continue;
         }
-        let lo = w.topo.min.get(axis) + cc[axis] as f64 * sc.cell_side[axis];
+        let lo = state.topo.min.get(axis) + cc[axis] as f64 * sc.cell_side[axis];
         let (bound, outward) = if up {
             (lo + sc.cell_side[axis], 1.0)
         } else {
@@ -289,22 +290,22 @@ pub(super) fn predict_crossing_straight<V: Vector>(
 /// the box's other side when it left the box through a periodic border.
 #[allow(clippy::needless_range_loop)]
 pub(super) fn cross_cell<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     tag: u32,
     t: f64,
 ) {
-    advance(w, sc, a, t);
+    advance(state, sc, a, t);
     let (axis, dir) = ((tag / 2) as usize, tag % 2);
     let old = sc.cell[a as usize] as usize;
     let mut cc = sc.coord[a as usize];
     cc[axis] += if dir == 1 { 1 } else { -1 };
     let n = sc.dims[axis] as i64;
     if cc[axis] < 0 || cc[axis] >= n {
-        if w.topo.wraps() {
-            let len = w.topo.size().get(axis);
-            let c = w.critters.slot_mut_moving(a).expect("live slot");
+        if state.topo.wraps() {
+            let len = state.topo.size().get(axis);
+            let c = state.critters.slot_mut_moving(a).expect("live slot");
             let x = c.pos.get(axis);
             c.pos.set(axis, if dir == 1 { x - len } else { x + len });
         }
@@ -335,34 +336,37 @@ pub(super) fn move_cell<V: Vector>(
 
 /// After a hook ran: the critter may have died or been moved; put it in the right cell (with
 /// shells, list it again if it left its shell).
-pub(super) fn relocate<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
+pub(super) fn relocate<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
     if sc.shells {
         // Listed again when it died, grew, or was moved out of its shell.
-        let stays = w.critters.slot(a).is_some_and(|c| {
+        let stays = state.critters.slot(a).is_some_and(|c| {
             c.alive
                 && c.radius == sc.body[a as usize].radius
-                && w.topo
+                && state
+                    .topo
                     .delta(sc.shell_centres[a as usize].pos, c.pos)
                     .length()
                     <= 0.5 * sc.shell_width
         });
         if !stays {
-            refresh_body(w, sc, a);
-            relist(w, sc, a);
+            refresh_body(state, sc, a);
+            relist(state, sc, a);
         }
         return;
     }
     let old = sc.cell[a as usize] as usize;
-    let Some(c) = w.critters.slot(a) else { return };
+    let Some(c) = state.critters.slot(a) else {
+        return;
+    };
     if !c.alive {
         sc.cells.remove(old, a);
         return;
     }
     let mut p = c.pos;
-    if w.topo.wraps() {
-        p = w.topo.wrap_position(p);
-        w.critters.slot_mut_moving(a).expect("live").pos = p;
+    if state.topo.wraps() {
+        p = state.topo.wrap_position(p);
+        state.critters.slot_mut_moving(a).expect("live").pos = p;
     }
-    let (new, cc) = cell_of(w, sc, p);
+    let (new, cc) = cell_of(state, sc, p);
     move_cell(sc, a, old, new, cc);
 }

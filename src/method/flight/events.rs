@@ -140,9 +140,9 @@ pub(super) fn offer(sc: &mut Scratch<impl Vector>, time: f64, a: u32, b: u32, ki
 /// with shells), so that the loads overlap the work on the event before it. Only a hint:
 /// nothing is read.
 #[inline]
-pub(super) fn prefetch_event<V: Vector>(w: &State<V>, sc: &Scratch<V>, ev: &Event) {
+pub(super) fn prefetch_event<V: Vector>(state: &State<V>, sc: &Scratch<V>, ev: &Event) {
     use crate::prefetch::prefetch;
-    let slots = w.critters.slot_slice();
+    let slots = state.critters.slot_slice();
     for x in [ev.owner, ev.other] {
         let x = x as usize;
         prefetch(sc.body.get(x));

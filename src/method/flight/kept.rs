@@ -94,14 +94,14 @@ fn against<V: Vector>(
 /// borders the disks into the box; then surveys them for the next step ([`EndSurvey`]), in the
 /// same pass: a step of a kept flight reads every critter once.
 #[allow(clippy::needless_range_loop)] // bodies, statuses and slots indexed together
-pub(super) fn end_flight<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, end: f64) {
-    let topo = w.topo;
-    let n = sc.body.len().min(w.critters.slot_count());
+pub(super) fn end_flight<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, end: f64) {
+    let topo = state.topo;
+    let n = sc.body.len().min(state.critters.slot_count());
     let mut changed = std::mem::take(&mut sc.changed);
     changed.clear();
     let (mut lost, mut disks) = (false, 0usize);
     let straight = sc.straight;
-    let slots = &mut w.critters.slots_mut_moving()[..n];
+    let slots = &mut state.critters.slots_mut_moving()[..n];
     for a in 0..n {
         let s = sc.status[a];
         // As `advance` (a line needs no acceleration, the most common case).
@@ -150,7 +150,7 @@ pub(super) fn end_flight<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, end: 
         }
     }
     sc.changed = changed;
-    let mark = w.critters.mark_untouched();
+    let mark = state.critters.mark_untouched();
     sc.ended = EndSurvey { mark, lost, disks };
 }
 
@@ -176,19 +176,19 @@ pub(super) fn steps_to_live(keep: bool, step: u64) -> u64 {
 
 /// A kept flight flown on for one more step of `length`, from where the last one ended.
 pub(super) fn fly_kept<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     length: f64,
     stats: &mut StepStats,
 ) -> Result<Option<f64>, Error> {
     let start = sc.ended_at;
-    match fly(w, sc, acc, Some(start), length, 1, stats)? {
+    match fly(state, sc, acc, Some(start), length, 1, stats)? {
         FlightEnd::Done(stopped) => Ok(stopped),
         FlightEnd::Grown(t) => {
             // The rest of the step in new flights, sized for the grown critter.
             let virial = sc.virial;
-            let rest = fly_new(w, sc, acc, length - t, 1, stats);
+            let rest = fly_new(state, sc, acc, length - t, 1, stats);
             sc.virial += virial;
             sc.outgrown = true;
             Ok(rest?.map(|r| t + r))
@@ -204,18 +204,18 @@ pub(super) fn fly_kept<V: Vector>(
 /// the flight cannot go on (the caller counts that as churned): a critter came or went, changed
 /// size, class or mobility, or a wall moved; the step then sets up a new flight.
 pub(super) fn take_up_kept<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     step: u64,
 ) -> Result<bool, Error> {
-    let n = w.critters.slot_count();
+    let n = state.critters.slot_count();
     if n != sc.body.len() {
         return Ok(false);
     }
     let start = sc.ended_at;
     let mut changed = std::mem::take(&mut sc.changed);
     let ended = sc.ended;
-    let disks = if w.critters.untouched_since(ended.mark) {
+    let disks = if state.critters.untouched_since(ended.mark) {
         // Nothing touched the critters since the last flight's end surveyed them.
         if ended.lost {
             sc.changed = changed;
@@ -225,7 +225,7 @@ pub(super) fn take_up_kept<V: Vector>(
     } else {
         changed.clear();
         let mut disks = 0usize;
-        for (a, slot) in w.critters.slot_slice().iter().enumerate() {
+        for (a, slot) in state.critters.slot_slice().iter().enumerate() {
             match against(slot, &sc.body[a], &sc.status[a], start) {
                 Against::Lost => {
                     sc.changed = changed;
@@ -251,10 +251,12 @@ pub(super) fn take_up_kept<V: Vector>(
         sc.body[a as usize].t = start;
         let s = &mut sc.status[a as usize];
         s.changes = s.changes.wrapping_add(1);
-        relocate(w, sc, a);
-        refresh_body(w, sc, a);
+        relocate(state, sc, a);
+        refresh_body(state, sc, a);
     }
-    let out = changed.iter().try_for_each(|&a| predict(w, sc, a, start));
+    let out = changed
+        .iter()
+        .try_for_each(|&a| predict(state, sc, a, start));
     sc.changed = changed;
     out.map(|()| true)
 }

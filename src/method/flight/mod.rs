@@ -239,7 +239,7 @@ impl<V: Vector> Scratch<V> {
 /// start only if it may meet something along its line (`may_meet`); otherwise it joins in when
 /// a collision changes its flight. The events are the same as when everyone predicts.
 pub(crate) fn run<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     span: Span,
@@ -251,7 +251,7 @@ pub(crate) fn run<V: Vector>(
     sc.dt = span.dt;
     sc.slow_below = slow_below;
     sc.outgrown = false;
-    let step = w.step_count;
+    let step = state.step_count;
     // Kept only for straight flights in which everyone predicts (a curved prediction would have
     // to look steps ahead; a slow critter that predicts nothing would miss later steps' events).
     let keep = keep && slow_below.is_none() && acc.length_squared() == 0.0;
@@ -263,15 +263,15 @@ pub(crate) fn run<V: Vector>(
         .filter(|k| keep && k.step == step && k.dt == t_end && !step.is_multiple_of(FLIGHT_STEPS));
     let life = steps_to_live(keep, step);
     let out = match kept {
-        Some(_) => match take_up_kept(w, sc, step) {
-            Ok(true) => fly_kept(w, sc, acc, t_end, stats),
+        Some(_) => match take_up_kept(state, sc, step) {
+            Ok(true) => fly_kept(state, sc, acc, t_end, stats),
             Ok(false) => {
                 sc.churned_at = Some(step);
-                fly_new(w, sc, acc, t_end, life, stats)
+                fly_new(state, sc, acc, t_end, life, stats)
             }
             Err(e) => Err(e),
         },
-        None => fly_new(w, sc, acc, t_end, life, stats),
+        None => fly_new(state, sc, acc, t_end, life, stats),
     };
     if keep && !sc.outgrown && matches!(out, Ok(None)) && !(step + 1).is_multiple_of(FLIGHT_STEPS) {
         sc.kept = Some(KeptFlight {
@@ -292,7 +292,7 @@ pub(crate) fn run<V: Vector>(
 /// step's method, for the error.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn carry_on<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     at: f64,
@@ -303,17 +303,17 @@ pub(crate) fn carry_on<V: Vector>(
 ) -> Result<(), Error> {
     let before = sc.processed;
     sc.carrying_on = true;
-    let out = run(w, sc, acc, rest, slow_below, false, stats);
+    let out = run(state, sc, acc, rest, slow_below, false, stats);
     sc.carrying_on = false;
     let Some(stopped) = out? else {
         return Ok(());
     };
     let pair = match sc.stopped_on.take() {
-        Some(ev) => describe(w, sc, &ev),
+        Some(ev) => describe(state, sc, &ev),
         None => "an event".to_string(),
     };
     Err(Error::EndlessEvents {
-        step: w.step_count,
+        step: state.step_count,
         method,
         events: before + sc.processed,
         at: at + stopped,
@@ -324,10 +324,10 @@ pub(crate) fn carry_on<V: Vector>(
 
 /// The critters of event `ev`, in words: its owner and what the owner last collided with
 /// (the pair an endless sequence repeats), or its partner when it has not collided yet.
-fn describe<V: Vector>(w: &State<V>, sc: &Scratch<V>, ev: &Event) -> String {
-    let name = |x: u32| match w.critters.slot(x) {
+fn describe<V: Vector>(state: &State<V>, sc: &Scratch<V>, ev: &Event) -> String {
+    let name = |x: u32| match state.critters.slot(x) {
         Some(c) if c.is_wall() => format!("wall {}", c.id),
-        Some(c) => format!("critter {} ({})", c.id, w.kinds.name(c.kind())),
+        Some(c) => format!("critter {} ({})", c.id, state.kinds.name(c.kind())),
         None => format!("slot {x}"),
     };
     let owner = name(ev.owner);
@@ -347,7 +347,7 @@ fn describe<V: Vector>(w: &State<V>, sc: &Scratch<V>, ev: &Event) -> String {
 /// everyone is brought to that time, and a new flight, sized for the grown critter, flies the
 /// rest.
 fn fly_new<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     t_end: f64,
@@ -359,7 +359,7 @@ fn fly_new<V: Vector>(
     loop {
         // A flight set up again after a critter grew lives to the step's end only.
         let life = if flown == 0.0 { life } else { 1 };
-        let outcome = fly(w, sc, acc, None, t_end - flown, life, stats);
+        let outcome = fly(state, sc, acc, None, t_end - flown, life, stats);
         virial += sc.virial;
         sc.virial = virial;
         match outcome? {
@@ -384,7 +384,7 @@ enum FlightEnd {
 /// sets up a new flight whose predictions look `life` steps of `length` ahead and flies it
 /// from 0.
 fn fly<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     from: Option<f64>,
@@ -392,7 +392,7 @@ fn fly<V: Vector>(
     life: u64,
     stats: &mut StepStats,
 ) -> Result<FlightEnd, Error> {
-    let n = w.critters.slot_count() as u32;
+    let n = state.critters.slot_count() as u32;
     let start = match from {
         Some(t) => t,
         None => {
@@ -403,19 +403,19 @@ fn fly<V: Vector>(
             } else {
                 length
             };
-            setup(w, sc, acc, horizon, life);
+            setup(state, sc, acc, horizon, life);
             match sc.slow_below {
                 Some(limit) => {
-                    mark_who_may_meet(w, sc);
+                    mark_who_may_meet(state, sc);
                     for a in 0..n {
                         if sc.reach[a as usize] > limit || sc.meets[a as usize] {
-                            predict(w, sc, a, 0.0)?;
+                            predict(state, sc, a, 0.0)?;
                         }
                     }
                 }
                 None => {
                     for a in 0..n {
-                        predict(w, sc, a, 0.0)?;
+                        predict(state, sc, a, 0.0)?;
                     }
                 }
             }
@@ -438,7 +438,7 @@ fn fly<V: Vector>(
                 continue;
             }
             Validity::PartnerChanged => {
-                predict(w, sc, ev.owner, ev.time)?;
+                predict(state, sc, ev.owner, ev.time)?;
                 continue;
             }
             Validity::Valid => {}
@@ -463,27 +463,28 @@ fn fly<V: Vector>(
                 }
             }
             if let Some(next) = sc.queue.runner_up() {
-                prefetch_event(w, sc, &next);
+                prefetch_event(state, sc, &next);
             }
         }
         let (a, b) = (ev.owner, ev.other);
         match ev.kind {
             EventKind::Pair | EventKind::Wall => {
-                advance(w, sc, a, t);
-                advance(w, sc, b, t);
+                advance(state, sc, a, t);
+                advance(state, sc, b, t);
                 stats.contacts += 1;
-                let deaths = w.pending.deaths.len();
-                if collide(w, sc, a, b, t)? {
+                let deaths = state.pending.deaths.len();
+                if collide(state, sc, a, b, t)? {
                     stats.collisions += 1;
                 }
                 // A hook may kill third critters: their bodies must know.
-                for i in deaths..w.pending.deaths.len() {
-                    let x = w.pending.deaths[i].index;
-                    refresh_body(w, sc, x);
+                for i in deaths..state.pending.deaths.len() {
+                    let x = state.pending.deaths[i].index;
+                    refresh_body(state, sc, x);
                 }
-                if let (Some(x), Some(y)) = (w.critters.slot(a), w.critters.slot(b)) {
+                if let (Some(x), Some(y)) = (state.critters.slot(a), state.critters.slot(b)) {
                     if x.alive && y.alive {
-                        if let Some(c) = crate::default_response::contact_between(&w.topo, x, y) {
+                        if let Some(c) = crate::default_response::contact_between(&state.topo, x, y)
+                        {
                             if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {
                                 sc.stuck.insert(pair_key(a, b));
                             }
@@ -497,11 +498,11 @@ fn fly<V: Vector>(
                     sc.last_collision[b as usize] = t;
                 }
                 for x in [a, b] {
-                    if w.critters.slot(x).is_some_and(|c| !c.is_wall()) {
+                    if state.critters.slot(x).is_some_and(|c| !c.is_wall()) {
                         let s = &mut sc.status[x as usize];
                         s.changes = s.changes.wrapping_add(1);
-                        relocate(w, sc, x);
-                        refresh_body(w, sc, x);
+                        relocate(state, sc, x);
+                        refresh_body(state, sc, x);
                     }
                 }
                 // A radius (NaN for walls and the dead) beyond what the cells were sized for:
@@ -515,31 +516,31 @@ fn fly<V: Vector>(
                     break;
                 }
                 for x in [a, b] {
-                    predict(w, sc, x, t)?;
+                    predict(state, sc, x, t)?;
                 }
             }
             EventKind::Border => {
-                advance(w, sc, a, t);
-                bounce_border(w, a, b);
-                refresh_body(w, sc, a);
+                advance(state, sc, a, t);
+                bounce_border(state, a, b);
+                refresh_body(state, sc, a);
                 sc.last_partner[a as usize] = BORDER_PARTNER + b;
                 let s = &mut sc.status[a as usize];
                 s.changes = s.changes.wrapping_add(1);
-                predict(w, sc, a, t)?;
+                predict(state, sc, a, t)?;
             }
             EventKind::CellCrossing => {
-                cross_cell(w, sc, a, b, t);
-                refresh_body(w, sc, a);
-                predict_after_crossing(w, sc, a, b, t)?;
+                cross_cell(state, sc, a, b, t);
+                refresh_body(state, sc, a);
+                predict_after_crossing(state, sc, a, b, t)?;
             }
             EventKind::ShellExit => {
-                advance(w, sc, a, t);
-                relist(w, sc, a);
-                predict(w, sc, a, t)?;
+                advance(state, sc, a, t);
+                relist(state, sc, a);
+                predict(state, sc, a, t)?;
             }
             EventKind::Recheck => {
                 // Continue a curved prediction that did not settle.
-                predict(w, sc, a, t)?;
+                predict(state, sc, a, t)?;
             }
         }
     }
@@ -550,7 +551,7 @@ fn fly<V: Vector>(
     // Everyone to the end of the flight.
     let end = grown.or(stopped).unwrap_or(t_end);
     sc.ended_at = end;
-    end_flight(w, sc, end);
+    end_flight(state, sc, end);
     Ok(match grown {
         Some(t) => FlightEnd::Grown(t - start),
         None => FlightEnd::Done(stopped.map(|t| t - start)),
@@ -559,24 +560,24 @@ fn fly<V: Vector>(
 
 /// Hands a touching pair to the caller's `collide` hook (Pop's roles), with the TC model.
 fn collide<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
     t: f64,
 ) -> Result<bool, Error> {
     let (ca, cb) = (
-        w.critters.slot(a).expect("live"),
-        w.critters.slot(b).expect("live"),
+        state.critters.slot(a).expect("live"),
+        state.critters.slot(b).expect("live"),
     );
-    let rule = match w
+    let rule = match state
         .rules
-        .rule(&w.kinds, &w.topo, ca, cb)
-        .map_err(|e| at_step(e, w.step_count))?
+        .rule(&state.kinds, &state.topo, ca, cb)
+        .map_err(|e| at_step(e, state.step_count))?
     {
         Some(r) => r,
-        None => crate::rules::roles_of(&w.kinds, &w.topo, ca, cb)
-            .map_err(|e| at_step(e, w.step_count))?,
+        None => crate::rules::roles_of(&state.kinds, &state.topo, ca, cb)
+            .map_err(|e| at_step(e, state.step_count))?,
     };
     let Some((caller, arg)) = roles_order(rule, ca, cb) else {
         return Ok(false);
@@ -586,9 +587,9 @@ fn collide<V: Vector>(
     let recent = |x: u32| t - sc.last_collision[x as usize] < sc.tc_window;
     let tc = recent(a) || (!cb.is_wall() && recent(b));
     let saved = if tc {
-        let e = [a, b].map(|x| w.critters.slot(x).map_or(1.0, |c| c.restitution()));
+        let e = [a, b].map(|x| state.critters.slot(x).map_or(1.0, |c| c.restitution()));
         for x in [a, b] {
-            if let Some(c) = w.critters.slot_mut(x) {
+            if let Some(c) = state.critters.slot_mut(x) {
                 c.traits_mut().restitution = 1.0;
             }
         }
@@ -596,19 +597,20 @@ fn collide<V: Vector>(
     } else {
         None
     };
-    let before = w.events.collisions.len();
-    let out = w.collide_pair(caller, arg);
+    let before = state.events.collisions.len();
+    let out = state.collide_pair(caller, arg);
     if let Some(e) = saved {
         for (x, e) in [a, b].into_iter().zip(e) {
-            if let Some(c) = w.critters.slot_mut(x) {
+            if let Some(c) = state.critters.slot_mut(x) {
                 if c.restitution() == 1.0 {
                     c.traits_mut().restitution = e;
                 }
             }
         }
     }
-    for ev in &w.events.collisions[before..] {
-        let (Some(c1), Some(c2)) = (w.critters.get(ev.caller), w.critters.get(ev.arg)) else {
+    for ev in &state.events.collisions[before..] {
+        let (Some(c1), Some(c2)) = (state.critters.get(ev.caller), state.critters.get(ev.arg))
+        else {
             continue;
         };
         if !c1.is_wall() && !c2.is_wall() {

@@ -29,7 +29,7 @@ const CA_ITERATIONS: usize = 64;
 
 /// Predicts every next event of disk `a` from time `t`.
 pub(super) fn predict<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
@@ -63,27 +63,27 @@ pub(super) fn predict<V: Vector>(
         }
         // When `a` leaves its shell: offered last (`finish_prediction`), but a bound for the
         // pairs from the start.
-        exit = shell_exit(w, sc, a, t, motion);
-        let out = predict_straight_partners(w, sc, a, &partners, t, motion, exit);
+        exit = shell_exit(state, sc, a, t, motion);
+        let out = predict_straight_partners(state, sc, a, &partners, t, motion, exit);
         sc.partners = partners;
         out?;
     } else if interior::<V>(sc, a) {
         // The common case: the neighbours are fixed offsets away, no wrapping, no repeats.
         for i in 0..sc.offsets.len() {
             let k = (home as isize + sc.offsets[i]) as usize;
-            scan_cell(w, sc, a, k, t, motion)?;
+            scan_cell(state, sc, a, k, t, motion)?;
         }
     } else {
-        scan_edge_neighbours(w, sc, a, t, motion)?;
+        scan_edge_neighbours(state, sc, a, t, motion)?;
     }
-    finish_prediction(w, sc, a, home, t, motion, exit)
+    finish_prediction(state, sc, a, home, t, motion, exit)
 }
 
 /// Ends a prediction of `a` (in cell `home`) whose disk candidates are in: walls, then the
 /// pair and wall event kept as `earliest_contact`, then borders and the cell crossing or the
 /// shell's `exit`, and the earliest goes to the queue.
 fn finish_prediction<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     home: usize,
@@ -94,21 +94,21 @@ fn finish_prediction<V: Vector>(
     if sc.has_walls {
         for i in 0..sc.cell_walls[home].len() {
             let b = sc.cell_walls[home][i];
-            predict_general(w, sc, a, b, t, motion)?;
+            predict_general(state, sc, a, b, t, motion)?;
         }
     }
     if !sc.shells {
         sc.earliest_contact[a as usize] = sc.earliest; // (read by cell crossings only)
     }
-    predict_border(w, sc, a, t, motion);
+    predict_border(state, sc, a, t, motion);
     if sc.shells {
         if let Some(at) = exit {
             offer(sc, at, a, 0, EventKind::ShellExit);
         }
     } else if sc.straight {
-        predict_crossing_straight(w, sc, a, t, motion);
+        predict_crossing_straight(state, sc, a, t, motion);
     } else {
-        predict_crossing(w, sc, a, t);
+        predict_crossing(state, sc, a, t);
     }
     match sc.earliest.take() {
         Some(ev) => sc.queue.set(ev),
@@ -123,7 +123,7 @@ fn finish_prediction<V: Vector>(
 /// kept `earliest_contact` stands for the rest while its partner has not changed. Otherwise (a
 /// changed partner, a curved flight, an edge cell) the full prediction.
 pub(super) fn predict_after_crossing<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     tag: u32,
@@ -133,7 +133,7 @@ pub(super) fn predict_after_crossing<V: Vector>(
     let kept = sc.earliest_contact[a as usize];
     let kept_valid = kept.is_none_or(|ev| matches!(validity(sc, &ev), Validity::Valid));
     if !(sc.straight && kept_valid && interior::<V>(sc, a) && sc.status[a as usize].alive) {
-        return predict(w, sc, a, t);
+        return predict(state, sc, a, t);
     }
     sc.predictions += 1;
     sc.earliest = kept;
@@ -142,20 +142,20 @@ pub(super) fn predict_after_crossing<V: Vector>(
     let mut out = Ok(());
     for &o in &front {
         let k = (home as isize + o) as usize;
-        out = scan_cell(w, sc, a, k, t, motion);
+        out = scan_cell(state, sc, a, k, t, motion);
         if out.is_err() {
             break;
         }
     }
     sc.front[tag as usize] = front;
     out?;
-    finish_prediction(w, sc, a, home, t, motion, None)
+    finish_prediction(state, sc, a, home, t, motion, None)
 }
 
 /// Predicts `a` against the disks of cell `k`.
 #[inline(always)]
 fn scan_cell<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     k: usize,
@@ -166,7 +166,7 @@ fn scan_cell<V: Vector>(
     for i in 0..n {
         let b = sc.cells.members(k)[i];
         if b != a {
-            predict_partner(w, sc, a, b, t, motion)?;
+            predict_partner(state, sc, a, b, t, motion)?;
         }
     }
     Ok(())
@@ -175,16 +175,16 @@ fn scan_cell<V: Vector>(
 /// Predicts `a`, in a cell at the edge of the grid, against the disks of the cells around
 /// it: wrapped or cut at the border, each cell once.
 fn scan_edge_neighbours<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     t: f64,
     motion: Motion<V>,
 ) -> Result<(), Error> {
     let mut around = [0usize; 27];
-    let count = cells_around(w, sc, a, &mut around);
+    let count = cells_around(state, sc, a, &mut around);
     for &k in &around[..count] {
-        scan_cell(w, sc, a, k, t, motion)?;
+        scan_cell(state, sc, a, k, t, motion)?;
     }
     Ok(())
 }
@@ -279,7 +279,7 @@ fn straight_contact<V: Vector>(
 /// [`straight_contact`] inline; everything else by [`predict_general`].
 #[inline(always)]
 fn predict_partner<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -287,13 +287,13 @@ fn predict_partner<V: Vector>(
     motion: Motion<V>,
 ) -> Result<(), Error> {
     if !sc.straight || sc.body[b as usize].radius.is_nan() {
-        return predict_general(w, sc, a, b, t, motion);
+        return predict_general(state, sc, a, b, t, motion);
     }
     sc.pair_tests += 1;
     let me = Straight::new(sc, a, t, motion);
     let cutoff = me.cutoff(sc.earliest.map_or(f64::INFINITY, |e| e.time));
-    match straight_contact(&w.topo, &me, &sc.body[b as usize], cutoff) {
-        Some(s) => offer_contact(w, sc, a, b, t, s, EventKind::Pair),
+    match straight_contact(&state.topo, &me, &sc.body[b as usize], cutoff) {
+        Some(s) => offer_contact(state, sc, a, b, t, s, EventKind::Pair),
         None => Ok(()),
     }
 }
@@ -304,7 +304,7 @@ fn predict_partner<V: Vector>(
 /// after `a` leaves its shell (`exit`) is dropped too: the shell's exit, offered after the
 /// pairs, would win over it, so the chosen event is the same.
 fn predict_straight_partners<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     partners: &[u32],
@@ -314,7 +314,7 @@ fn predict_straight_partners<V: Vector>(
 ) -> Result<(), Error> {
     let me = Straight::new(sc, a, t, motion);
     // A copy: the loop's calls borrow the world mutably.
-    let topo = w.topo;
+    let topo = state.topo;
     let exit = exit.unwrap_or(f64::INFINITY);
     let cutoff =
         |sc: &Scratch<V>| me.cutoff(sc.earliest.map_or(f64::INFINITY, |e| e.time).min(exit));
@@ -323,13 +323,13 @@ fn predict_straight_partners<V: Vector>(
     for &b in partners {
         let body = sc.body[b as usize];
         if body.radius.is_nan() {
-            predict_general(w, sc, a, b, t, motion)?;
+            predict_general(state, sc, a, b, t, motion)?;
             cut = cutoff(sc);
             continue;
         }
         tests += 1;
         if let Some(s) = straight_contact(&topo, &me, &body, cut) {
-            offer_contact(w, sc, a, b, t, s, EventKind::Pair)?;
+            offer_contact(state, sc, a, b, t, s, EventKind::Pair)?;
             cut = cutoff(sc);
         }
     }
@@ -341,7 +341,7 @@ fn predict_straight_partners<V: Vector>(
 /// and any flights (curved ones by conservative advancement).
 #[inline]
 fn predict_general<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -364,13 +364,13 @@ fn predict_general<V: Vector>(
         acc: aa,
     } = motion;
     let (kind, s) = if status_b.wall {
-        let Some(cb) = w.critters.slot(b) else {
+        let Some(cb) = state.critters.slot(b) else {
             return Ok(());
         };
         let Shape::Wall(wall) = cb.shape() else {
             return Ok(());
         };
-        let d = w.topo.delta(cb.pos, pa);
+        let d = state.topo.delta(cb.pos, pa);
         let r = body_a.radius * (1.0 - SKIN);
         let s = if aa.length_squared() == 0.0 {
             toi_wall_ball(wall, d, va, r)
@@ -404,7 +404,7 @@ fn predict_general<V: Vector>(
             vel: vb,
             acc: ab,
         } = motion_at(sc, b, t);
-        let d = w.topo.delta(pa, pb);
+        let d = state.topo.delta(pa, pb);
         let wv = vb - va;
         let ar = ab - aa;
         let r = (body_a.radius + body_b.radius) * (1.0 - SKIN);
@@ -430,7 +430,7 @@ fn predict_general<V: Vector>(
         if s > ahead || sc.earliest.is_some_and(|e| t + s > e.time) {
             return Ok(());
         }
-        offer_contact(w, sc, a, b, t, s, kind)?;
+        offer_contact(state, sc, a, b, t, s, kind)?;
     }
     Ok(())
 }
@@ -439,7 +439,7 @@ fn predict_general<V: Vector>(
 /// they don't collide, or they touch now and were just handled.
 #[inline(never)]
 fn offer_contact<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     a: u32,
     b: u32,
@@ -448,16 +448,17 @@ fn offer_contact<V: Vector>(
     kind: EventKind,
 ) -> Result<(), Error> {
     let (status_a, status_b) = (sc.status[a as usize], sc.status[b as usize]);
-    let rule = match w.rules.cached(status_a.class, status_b.class) {
+    let rule = match state.rules.cached(status_a.class, status_b.class) {
         Some(rule) => rule,
         None => {
             let (ca, cb) = (
-                w.critters.slot(a).expect("live"),
-                w.critters.slot(b).expect("live"),
+                state.critters.slot(a).expect("live"),
+                state.critters.slot(b).expect("live"),
             );
-            w.rules
-                .rule(&w.kinds, &w.topo, ca, cb)
-                .map_err(|e| at_step(e, w.step_count))?
+            state
+                .rules
+                .rule(&state.kinds, &state.topo, ca, cb)
+                .map_err(|e| at_step(e, state.step_count))?
         }
     };
     if rule == Some(PairRule::DontCollide) {

@@ -18,13 +18,13 @@ use crate::vector::Vector;
 /// Sets up a new flight of `life` steps whose predictions look to `horizon`.
 #[allow(clippy::needless_range_loop)] // per-axis arrays indexed together
 pub(super) fn setup<V: Vector>(
-    w: &mut State<V>,
+    state: &mut State<V>,
     sc: &mut Scratch<V>,
     acc: V,
     horizon: f64,
     life: u64,
 ) {
-    let n = w.critters.slot_count();
+    let n = state.critters.slot_count();
     if life > 1 {
         // A kept flight's calendar covers its whole life (its later steps go on in it), with a
         // bucket per event of the last step, at most one per two critters a step: more
@@ -47,9 +47,9 @@ pub(super) fn setup<V: Vector>(
     let mut rmax: f64 = 0.0;
     let mut disks = 0usize;
     sc.has_walls = false;
-    for c in w.critters.iter_mut_moving() {
+    for c in state.critters.iter_mut_moving() {
         if c.class == CLASS_UNSET {
-            c.class = w.rules.class_of(&w.kinds, c);
+            c.class = state.rules.class_of(&state.kinds, c);
         }
         if c.alive && !c.is_wall() {
             rmax = rmax.max(c.radius);
@@ -66,7 +66,7 @@ pub(super) fn setup<V: Vector>(
     sc.status.clear();
     sc.status.resize(n, Status::default());
     for a in 0..n as u32 {
-        refresh_body(w, sc, a);
+        refresh_body(state, sc, a);
     }
     sc.last_collision.clear();
     sc.last_collision.resize(n, f64::NEG_INFINITY);
@@ -97,7 +97,7 @@ pub(super) fn setup<V: Vector>(
     // not predict never cross cells: a slow one may end up `slow_below` out of its cell, and two
     // slow ones that meet were up to a diameter and twice `slow_below` apart (`may_meet` looks
     // one cell around).
-    let size = w.topo.size();
+    let size = state.topo.size();
     let dim = V::DIM;
     let slack = sc.shell_width + 2.0 * sc.slow_below.unwrap_or(0.0);
     let want = (2.0 * rmax * (1.0 + ROUNDING_MARGIN) + slack * (1.0 + ROUNDING_MARGIN))
@@ -160,9 +160,9 @@ pub(super) fn setup<V: Vector>(
     let mut load = std::mem::take(&mut sc.cells.data);
     load.clear();
     load.resize(total, 0);
-    for c in w.critters.iter() {
+    for c in state.critters.iter() {
         if c.alive && !c.is_wall() {
-            let (k, cc) = cell_of(w, sc, c.pos);
+            let (k, cc) = cell_of(state, sc, c.pos);
             debug_assert_eq!(cell_coords(&dims, k), cc, "cell {k}'s coordinates");
             sc.cell[c.id.index as usize] = k as u32;
             sc.coord[c.id.index as usize] = cc;
@@ -175,7 +175,7 @@ pub(super) fn setup<V: Vector>(
     sc.cell_walls.iter_mut().for_each(Vec::clear);
     sc.cell_walls
         .resize_with(if sc.has_walls { total } else { 0 }, Vec::new);
-    for c in w.critters.iter() {
+    for c in state.critters.iter() {
         if !c.alive {
             continue;
         }
@@ -190,12 +190,12 @@ pub(super) fn setup<V: Vector>(
                 let mut lo = [0i64; 3];
                 let mut hi = [0i64; 3];
                 for axis in 0..dim {
-                    let m = w.topo.min.get(axis);
+                    let m = state.topo.min.get(axis);
                     let s = sc.cell_side[axis];
                     lo[axis] = ((c.pos.get(axis) - half.get(axis) - m) / s).floor() as i64;
                     hi[axis] = ((c.pos.get(axis) + half.get(axis) - m) / s).floor() as i64;
                     let n = dims[axis] as i64;
-                    if w.topo.wraps() {
+                    if state.topo.wraps() {
                         if hi[axis] - lo[axis] + 1 >= n {
                             lo[axis] = 0;
                             hi[axis] = n - 1;
@@ -217,7 +217,7 @@ pub(super) fn setup<V: Vector>(
         }
     }
     if sc.shells {
-        list_all_neighbours(w, sc);
+        list_all_neighbours(state, sc);
     }
 }
 
@@ -234,17 +234,17 @@ fn reach<V: Vector>(sc: &Scratch<V>, a: u32) -> f64 {
 /// The flight asks [`mark_who_may_meet`], which gives the same answers pair by pair; this is
 /// its definition, which the tests compare it with.
 #[cfg(test)]
-pub(super) fn may_meet<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32) -> bool {
+pub(super) fn may_meet<V: Vector>(state: &State<V>, sc: &Scratch<V>, a: u32) -> bool {
     let body = sc.body[a as usize];
     if body.radius.is_nan() {
         return false;
     }
     let moves = reach(sc, a);
-    if near_border(w, body, moves) || (sc.has_walls && near_a_wall(w, sc, a, moves)) {
+    if near_border(state, body, moves) || (sc.has_walls && near_a_wall(state, sc, a, moves)) {
         return true;
     }
     let mut around = [0usize; 27];
-    let count = cells_around(w, sc, a, &mut around);
+    let count = cells_around(state, sc, a, &mut around);
     for &k in &around[..count] {
         for &b in sc.cells.members(k) {
             let other = sc.body[b as usize];
@@ -252,7 +252,7 @@ pub(super) fn may_meet<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32) -> bool
                 continue;
             }
             let near = body.radius + other.radius + moves + reach(sc, b);
-            if w.topo.delta(body.pos, other.pos).length_squared() <= near * near {
+            if state.topo.delta(body.pos, other.pos).length_squared() <= near * near {
                 return true;
             }
         }
@@ -262,31 +262,31 @@ pub(super) fn may_meet<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32) -> bool
 
 /// Whether a disk `body` that moves up to `moves` may reach a bounding border.
 #[inline]
-fn near_border<V: Vector>(w: &State<V>, body: Body<V>, moves: f64) -> bool {
-    if w.topo.border == Border::Wrap {
+fn near_border<V: Vector>(state: &State<V>, body: Body<V>, moves: f64) -> bool {
+    if state.topo.border == Border::Wrap {
         return false;
     }
     (0..V::DIM).any(|axis| {
         let x = body.pos.get(axis);
-        let room = (x - w.topo.min.get(axis)).min(w.topo.max.get(axis) - x);
+        let room = (x - state.topo.min.get(axis)).min(state.topo.max.get(axis) - x);
         room <= body.radius + moves
     })
 }
 
 /// Whether disk `a`, moving up to `moves`, may reach a wall listed in the cells around its own.
-fn near_a_wall<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32, moves: f64) -> bool {
+fn near_a_wall<V: Vector>(state: &State<V>, sc: &Scratch<V>, a: u32, moves: f64) -> bool {
     let body = sc.body[a as usize];
     let mut around = [0usize; 27];
-    let count = cells_around(w, sc, a, &mut around);
+    let count = cells_around(state, sc, a, &mut around);
     for &k in &around[..count] {
         for &x in &sc.cell_walls[k] {
-            let Some(c) = w.critters.slot(x) else {
+            let Some(c) = state.critters.slot(x) else {
                 continue;
             };
             let Shape::Wall(wall) = c.shape() else {
                 continue;
             };
-            let d = w.topo.delta(c.pos, body.pos);
+            let d = state.topo.delta(c.pos, body.pos);
             if c.alive && contact_wall_ball(wall, d, body.radius + moves).is_some() {
                 return true;
             }
@@ -300,7 +300,7 @@ fn near_a_wall<V: Vector>(w: &State<V>, sc: &Scratch<V>, a: u32, moves: f64) -> 
 /// cells read once, in cell order, each pair of disks tested once for both of its disks, each
 /// side with `may_meet`'s own arithmetic), and the walls asked only by disks whose cell has a
 /// wall around it.
-pub(super) fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
+pub(super) fn mark_who_may_meet<V: Vector>(state: &State<V>, sc: &mut Scratch<V>) {
     let n = sc.body.len();
     let mut reaches = std::mem::take(&mut sc.reach);
     reaches.clear();
@@ -317,7 +317,7 @@ pub(super) fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
     if sc.has_walls {
         for k in 0..total {
             if !sc.cell_walls[k].is_empty() {
-                let count = cells_around_cell(w, sc, cell_coords(&dims, k), &mut around);
+                let count = cells_around_cell(state, sc, cell_coords(&dims, k), &mut around);
                 for &j in &around[..count] {
                     near_wall[j] = true;
                 }
@@ -330,8 +330,8 @@ pub(super) fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
             continue;
         }
         let moves = reaches[a];
-        meets[a] = near_border(w, body, moves)
-            || (near_wall[sc.cell[a] as usize] && near_a_wall(w, sc, a as u32, moves));
+        meets[a] = near_border(state, body, moves)
+            || (near_wall[sc.cell[a] as usize] && near_a_wall(state, sc, a as u32, moves));
     }
     // Disks in neighbouring cells. Cells off the grid's edges pair with the cells after them
     // (`forward`, each pair of cells once); the others with every cell around them.
@@ -342,7 +342,7 @@ pub(super) fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
         }
         let (ra, rb) = (reaches[a as usize], reaches[b as usize]);
         // `delta` is odd in its arguments bit for bit, so one squared distance serves both.
-        let d2 = w.topo.delta(ba.pos, bb.pos).length_squared();
+        let d2 = state.topo.delta(ba.pos, bb.pos).length_squared();
         let near_a = ba.radius + bb.radius + ra + rb;
         let near_b = bb.radius + ba.radius + rb + ra;
         if d2 <= near_a * near_a {
@@ -376,7 +376,7 @@ pub(super) fn mark_who_may_meet<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
                 }
             }
         } else {
-            let count = cells_around_cell(w, sc, hc, &mut around);
+            let count = cells_around_cell(state, sc, hc, &mut around);
             for &j in &around[..count] {
                 for &a in members {
                     for &b in sc.cells.members(j) {

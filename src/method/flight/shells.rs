@@ -22,7 +22,7 @@ pub(super) struct ShellCentre<V> {
 
 /// Lists every pair whose shells overlap (at the start of a flight, every shell is centred on
 /// its critter).
-pub(super) fn list_all_neighbours<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) {
+pub(super) fn list_all_neighbours<V: Vector>(state: &State<V>, sc: &mut Scratch<V>) {
     let n = sc.body.len();
     sc.shell_centres.clear();
     sc.shell_centres.extend(sc.body.iter().map(|b| ShellCentre {
@@ -36,10 +36,10 @@ pub(super) fn list_all_neighbours<V: Vector>(w: &State<V>, sc: &mut Scratch<V>) 
         if sc.body[a as usize].radius.is_nan() {
             continue;
         }
-        let count = cells_around(w, sc, a, &mut around);
+        let count = cells_around(state, sc, a, &mut around);
         for &k in &around[..count] {
             for &b in sc.cells.members(k) {
-                if b > a && shells_overlap(&w.topo, &sc.shell_centres, sc.shell_width, a, b) {
+                if b > a && shells_overlap(&state.topo, &sc.shell_centres, sc.shell_width, a, b) {
                     sc.neighbours.push(a as usize, b);
                     sc.neighbours.push(b as usize, a);
                 }
@@ -68,7 +68,7 @@ fn shells_overlap<V: Vector>(
 /// Lists `a` again, centring its shell on where it is now (its body holds now): it empties its
 /// list, moves to the cell of its new centre, and lists the critters whose shells overlap the
 /// new one (and joins their lists). Its flight is unchanged, so no event is made stale.
-pub(super) fn relist<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
+pub(super) fn relist<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
     let ai = a as usize;
     // The old neighbours keep `a` in their lists until they list again themselves: a pair
     // test too many costs less than finding `a` in every old list.
@@ -79,12 +79,12 @@ pub(super) fn relist<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
         return;
     }
     let mut p = sc.body[ai].pos;
-    if w.topo.wraps() {
-        let q = w.topo.wrap_position(p);
+    if state.topo.wraps() {
+        let q = state.topo.wrap_position(p);
         if q != p {
             p = q;
             sc.body[ai].pos = p;
-            if let Some(c) = w.critters.slot_mut_moving(a) {
+            if let Some(c) = state.critters.slot_mut_moving(a) {
                 c.pos = p;
             }
         }
@@ -93,10 +93,10 @@ pub(super) fn relist<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
         pos: p,
         radius: sc.body[ai].radius,
     };
-    let (new, cc) = cell_of(w, sc, p);
+    let (new, cc) = cell_of(state, sc, p);
     move_cell(sc, a, old, new, cc);
     let mut around = [0usize; 27];
-    let count = cells_around(w, sc, a, &mut around);
+    let count = cells_around(state, sc, a, &mut around);
     // The loads are scattered, so each stage asks for what the next one reads before it
     // reads any: the cells' stripes, then the candidates' shell centres (with their radii),
     // then the new neighbours' lists.
@@ -117,7 +117,7 @@ pub(super) fn relist<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
     let mut kept = 0;
     for i in 0..gathered.len() {
         let b = gathered[i];
-        let hit = (b != a) & shells_overlap(&w.topo, &sc.shell_centres, sc.shell_width, a, b);
+        let hit = (b != a) & shells_overlap(&state.topo, &sc.shell_centres, sc.shell_width, a, b);
         gathered[kept] = b;
         kept += usize::from(hit);
     }
@@ -143,14 +143,14 @@ pub(super) fn relist<V: Vector>(w: &mut State<V>, sc: &mut Scratch<V>, a: u32) {
 /// flight.
 #[inline]
 pub(super) fn shell_exit<V: Vector>(
-    w: &State<V>,
+    state: &State<V>,
     sc: &Scratch<V>,
     a: u32,
     t: f64,
     motion: Motion<V>,
 ) -> Option<f64> {
     let Motion { pos, vel, .. } = motion;
-    let d = w.topo.delta(sc.shell_centres[a as usize].pos, pos);
+    let d = state.topo.delta(sc.shell_centres[a as usize].pos, pos);
     let h = 0.5 * sc.shell_width;
     let c = d.length_squared() - h * h;
     let s = if c >= 0.0 {
