@@ -98,6 +98,10 @@ pub struct Critter<V: Vector> {
     /// True for a wall: what the shape says, kept in the record so that the passes over every
     /// critter need not read the traits. Not hashed (the kind says it too).
     pub(crate) wall: bool,
+    /// Set aside by the collision method for part of a step (a group of islands another
+    /// method steps, or a bullet flown on its own; see `method::aside`): alive, but out of play
+    /// until brought back. Never set between steps, so not hashed.
+    pub(crate) aside: bool,
     pub(crate) traits: Arc<Traits<V>>,
     pub(crate) _align: [V::CritterAlign; 0],
 }
@@ -176,6 +180,11 @@ impl<V: Vector> Critter<V> {
     /// False once the critter has died (it is removed at the end of the step).
     pub fn is_alive(&self) -> bool {
         self.alive
+    }
+    /// Alive and not set aside by the method: what the step's stages move, pair and collide.
+    #[inline]
+    pub(crate) fn in_play(&self) -> bool {
+        self.alive && !self.aside
     }
     /// True for walls.
     pub fn is_wall(&self) -> bool {

@@ -55,7 +55,10 @@ pub(crate) fn packing<V: Vector>(state: &State<V>) -> f64 {
     } else {
         4.0 / 3.0 * std::f64::consts::PI
     };
-    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let disks = state
+        .critters
+        .iter()
+        .filter(|c| c.in_play() && !c.is_wall());
     let covered: f64 = disks.map(|c| unit * c.radius.powi(V::DIM as i32)).sum();
     covered / volume
 }
@@ -205,13 +208,16 @@ pub const MOST_SOLVE_SUBSTEPS: u32 = 8;
 /// `scale` is the world's [`motion_scale`].
 pub(crate) fn tunnel_fraction<V: Vector>(state: &State<V>, scale: &MotionScale, dt: f64) -> f64 {
     let spare = (0.5 * scale.thinnest_wall).min(scale.smallest_radius);
-    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let disks = state
+        .critters
+        .iter()
+        .filter(|c| c.in_play() && !c.is_wall());
     disks
         .map(|c| displacement(state, c, dt) / (c.radius + spare))
         .fold(0.0, f64::max)
 }
 
-/// The method for the coming step of `dt` and why, for `world` whose event flight is `flight`
+/// The method for the coming step of `dt` and why, for `state` whose event flight is `flight`
 /// and in which `asleep` critters sleep.
 pub(crate) fn choose<V: Vector>(
     state: &State<V>,

@@ -45,7 +45,10 @@ pub(crate) fn find<V: Vector>(state: &State<V>, dt: f64, out: &mut Vec<u32>) -> 
     let limit = SOLVE_FRACTION * f64::from(MOST_SOLVE_SUBSTEPS);
     let mut moving = 0usize;
     for (i, c) in state.critters.slot_slice().iter().enumerate() {
-        let Some(c) = c.as_ref().filter(|c| c.alive && !c.is_wall() && !c.fixed) else {
+        let Some(c) = c
+            .as_ref()
+            .filter(|c| c.in_play() && !c.is_wall() && !c.fixed)
+        else {
             continue;
         };
         moving += 1;
@@ -79,14 +82,14 @@ pub(crate) fn fly<V: Vector>(
         .slot_slice()
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.as_ref().is_some_and(|c| c.alive && c.is_wall()))
+        .filter(|(_, c)| c.as_ref().is_some_and(|c| c.in_play() && c.is_wall()))
         .map(|(i, _)| i as u32)
         .collect();
     let (g, dt) = (state.gravity, span.dt);
     let mut near = Vec::new();
     for &b in bullets {
         match state.critters.slot_mut_moving(b) {
-            Some(c) if c.alive => c.vel += g * dt,
+            Some(c) if c.in_play() => c.vel += g * dt,
             _ => continue,
         }
         let mut left = dt;
@@ -94,7 +97,7 @@ pub(crate) fn fly<V: Vector>(
         // Critters this bullet touched whose pair did not collide: it passes through them.
         let mut passed: Vec<u32> = Vec::new();
         while left > 0.0 {
-            let Some(c) = state.critters.slot(b).filter(|c| c.alive) else {
+            let Some(c) = state.critters.slot(b).filter(|c| c.in_play()) else {
                 break;
             };
             let (p, v, r) = (c.pos, c.vel, c.radius);
@@ -124,7 +127,7 @@ pub(crate) fn fly<V: Vector>(
             }
         }
         let topo = state.topo;
-        if let Some(c) = state.critters.slot_mut_moving(b).filter(|c| c.alive) {
+        if let Some(c) = state.critters.slot_mut_moving(b).filter(|c| c.in_play()) {
             let e = c.restitution();
             (c.pos, c.vel) = topo.apply(c.pos, c.vel, c.radius, e);
         }
@@ -157,7 +160,7 @@ fn gather<V: Vector>(
     };
     state.neighbours.any_overlapping(at, p + half, reach, |c| {
         let slot = c.id.index;
-        if slot != me && c.alive && !is_bullet.get(slot as usize).copied().unwrap_or(false) {
+        if slot != me && c.in_play() && !is_bullet.get(slot as usize).copied().unwrap_or(false) {
             out.push(slot);
         }
         false

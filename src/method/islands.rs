@@ -131,7 +131,7 @@ pub(crate) fn partition<V: Vector>(state: &State<V>, asleep: &[bool], dt: f64) -
     let mut disks = Vec::new();
     let mut supports = Vec::new();
     for (i, c) in slots.iter().enumerate() {
-        let Some(c) = c.as_ref().filter(|c| c.alive) else {
+        let Some(c) = c.as_ref().filter(|c| c.in_play()) else {
             continue;
         };
         if c.is_wall() || c.fixed {

@@ -2,6 +2,7 @@
 //! the solve's warm starts and who sleeps. The world holds one [`MethodState`] and names none of
 //! its parts; each method is handed the world's state and pair lists explicitly.
 
+use super::aside;
 use super::auto::{self, Why};
 use super::discrete::{self, Respond};
 use super::islands;
@@ -36,6 +37,8 @@ pub(crate) struct MethodState<V: Vector> {
     /// `auto`'s bullets of the coming step (see `bullets`), by slot, and marked by slot.
     bullets: Vec<u32>,
     is_bullet: Vec<bool>,
+    /// The bullets set aside while the step is taken without them.
+    bullets_aside: Vec<u32>,
     pub(super) flight: flight::Scratch<V>,
     solve: solve::Scratch<V>,
     sleep: Sleep<V>,
@@ -76,6 +79,7 @@ impl<V: Vector> MethodState<V> {
             event_broad: None,
             bullets: Vec::new(),
             is_bullet: Vec::new(),
+            bullets_aside: Vec::new(),
             flight: Default::default(),
             solve: Default::default(),
             sleep: Sleep::new(sleep),
@@ -148,7 +152,7 @@ impl<V: Vector> MethodState<V> {
         let moving_fixed = state
             .critters
             .iter()
-            .any(|c| c.alive && c.fixed && !c.is_wall() && c.vel != V::zero());
+            .any(|c| c.in_play() && c.fixed && !c.is_wall() && c.vel != V::zero());
         if moving_fixed {
             return None;
         }
@@ -173,27 +177,22 @@ impl<V: Vector> MethodState<V> {
         Some(plan)
     }
 
-    /// Marks `auto`'s bullets not alive (and by slot in `is_bullet`).
+    /// Sets `auto`'s bullets aside (and marks them by slot in `is_bullet`).
     fn hide_bullets(&mut self, state: &mut State<V>) {
-        let slots = state.critters.slots_mut_moving();
+        let slots = state.critters.slot_slice();
         self.is_bullet.clear();
         self.is_bullet.resize(slots.len(), false);
         for &b in &self.bullets {
-            if let Some(Some(c)) = slots.get_mut(b as usize) {
-                c.alive = false;
+            if let Some(Some(_)) = slots.get(b as usize) {
                 self.is_bullet[b as usize] = true;
             }
         }
+        aside::set_aside(state, self.bullets.iter().copied(), &mut self.bullets_aside);
     }
 
-    /// Shows `auto`'s bullets again.
+    /// Brings `auto`'s bullets back.
     fn show_bullets(&mut self, state: &mut State<V>) {
-        let slots = state.critters.slots_mut_moving();
-        for &b in &self.bullets {
-            if let Some(Some(c)) = slots.get_mut(b as usize) {
-                c.alive = true;
-            }
-        }
+        aside::bring_back(state, &mut self.bullets_aside);
     }
 
     /// `auto`'s plan by islands for a scene that needs no swept step (`whole` is its plan and
@@ -233,7 +232,7 @@ impl<V: Vector> MethodState<V> {
         let mut slots = state.critters.slot_slice().iter().enumerate();
         slots.all(|(i, c)| {
             c.as_ref()
-                .is_none_or(|c| !c.alive || c.is_wall() || c.fixed || self.sleep.asleep(i))
+                .is_none_or(|c| !c.in_play() || c.is_wall() || c.fixed || self.sleep.asleep(i))
         })
     }
 

@@ -18,6 +18,7 @@
 //! While a group is stepped, hooks that look around (`nearby`) do not see the other group:
 //! it is out of reach for the whole step.
 
+use super::aside::{bring_back, set_aside};
 use super::islands::{Islands, Regime, ASLEEP, NO_ISLAND};
 use super::Method;
 use crate::step::state::State;
@@ -52,34 +53,24 @@ pub(crate) fn groups_by_slot(islands: &Islands, free_flies: bool, out: &mut Vec<
     }));
 }
 
-/// Marks not alive every live critter of another group than `keep` (their slots in `hidden`).
+/// Sets aside every critter in play of another group than `keep` (their slots in `hidden`).
 pub(crate) fn hide<V: Vector>(
     state: &mut State<V>,
     groups: &[u8],
     keep: u8,
     hidden: &mut Vec<u32>,
 ) {
-    hidden.clear();
-    let slots = state.critters.slots_mut_moving();
-    for (i, c) in slots.iter_mut().enumerate() {
+    let slots = state.critters.slot_count();
+    let others = (0..slots).filter(|&i| {
         let group = groups.get(i).copied().unwrap_or(NO_GROUP);
-        if let Some(c) = c.as_mut() {
-            if c.alive && group != NO_GROUP && group != keep {
-                c.alive = false;
-                hidden.push(i as u32);
-            }
-        }
-    }
+        group != NO_GROUP && group != keep
+    });
+    set_aside(state, others.map(|i| i as u32), hidden);
 }
 
-/// Shows again the critters [`hide`] hid.
+/// Brings back the critters [`hide`] set aside.
 pub(crate) fn show<V: Vector>(state: &mut State<V>, hidden: &mut Vec<u32>) {
-    let slots = state.critters.slots_mut_moving();
-    for i in hidden.drain(..) {
-        if let Some(Some(c)) = slots.get_mut(i as usize) {
-            c.alive = true;
-        }
-    }
+    bring_back(state, hidden);
 }
 
 /// The step's islands as `critterbox run` reports them: per regime, how many islands and

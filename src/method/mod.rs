@@ -20,6 +20,7 @@
 //! `flight` is the event engine `swept` and `event` share; [`toi`] holds the time-of-impact
 //! formulas.
 
+pub(crate) mod aside;
 pub mod auto;
 pub mod bullets;
 pub(crate) mod discrete;

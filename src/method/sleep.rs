@@ -219,7 +219,7 @@ impl<V: Vector> Sleep<V> {
         self.still.resize(n, false);
         for (i, c) in slots.iter().enumerate() {
             if !self.asleep(i) {
-                self.still[i] = c.as_ref().is_some_and(|c| c.alive && c.is_wall());
+                self.still[i] = c.as_ref().is_some_and(|c| c.in_play() && c.is_wall());
             }
         }
     }
@@ -252,12 +252,12 @@ impl<V: Vector> Sleep<V> {
         let mut all_still = true;
         for (i, c) in slots.iter().enumerate() {
             if !self.asleep(i) {
-                all_still &= c.as_ref().is_none_or(|c| c.alive && c.is_wall());
+                all_still &= c.as_ref().is_none_or(|c| c.in_play() && c.is_wall());
                 continue;
             }
             let (pos, radius) = self.rest[i];
             let kept = c.as_ref().is_some_and(|c| {
-                c.alive && !c.fixed && c.vel == V::zero() && c.pos == pos && c.radius == radius
+                c.in_play() && !c.fixed && c.vel == V::zero() && c.pos == pos && c.radius == radius
             });
             if !kept {
                 self.wake(i);
@@ -295,7 +295,7 @@ impl<V: Vector> Sleep<V> {
         self.quiet_now.clear();
         self.quiet_now.extend(slots.iter().map(|c| {
             c.as_ref()
-                .is_some_and(|c| c.alive && c.vel.length_squared() < limit)
+                .is_some_and(|c| c.in_play() && c.vel.length_squared() < limit)
         }));
         for &slot in &self.stirred {
             self.quiet_now[slot as usize] = false;
@@ -303,7 +303,7 @@ impl<V: Vector> Sleep<V> {
         // Critters that may sleep: live, free, not walls.
         let islander = |c: &Option<Critter<V>>| {
             c.as_ref()
-                .is_some_and(|c| c.alive && !c.is_wall() && !c.fixed)
+                .is_some_and(|c| c.in_play() && !c.is_wall() && !c.fixed)
         };
         // A sleeper that died in a hook wakes its island; so does one touched by a critter that
         // moves (walls never move).

@@ -215,7 +215,7 @@ pub(crate) fn respond<V: Vector>(
     };
     for (i, slot) in slots.iter().enumerate() {
         match slot {
-            Some(c) if c.alive => {
+            Some(c) if c.in_play() => {
                 // To an awake critter a sleeper is as heavy as a wall.
                 let asleep = still.get(i).copied().unwrap_or(false);
                 s.bodies.push(Body {
@@ -245,7 +245,7 @@ pub(crate) fn respond<V: Vector>(
         let (Some(ca), Some(cb)) = (state.critters.slot(a), state.critters.slot(b)) else {
             continue;
         };
-        if !ca.alive || !cb.alive {
+        if !ca.in_play() || !cb.in_play() {
             continue;
         }
         let Some(c) = crate::default_response::contact_between(&state.topo, ca, cb) else {

@@ -69,7 +69,7 @@ pub(crate) fn motion_scale<V: Vector>(state: &State<V>, dt: f64) -> MotionScale 
     // `displacement`, without a square root per critter.
     let g = state.gravity;
     let mut fastest_squared: f64 = 0.0;
-    for c in state.critters.iter().filter(|c| c.alive) {
+    for c in state.critters.iter().filter(|c| c.in_play()) {
         match c.wall() {
             Some(w) => {
                 for axis in 0..V::DIM {
@@ -90,7 +90,10 @@ pub(crate) fn motion_scale<V: Vector>(state: &State<V>, dt: f64) -> MotionScale 
 /// How many live disks move more than `limit` in the coming step of `dt`, and how many there
 /// are.
 pub(crate) fn count_fast<V: Vector>(state: &State<V>, limit: f64, dt: f64) -> (usize, usize) {
-    let disks = state.critters.iter().filter(|c| c.alive && !c.is_wall());
+    let disks = state
+        .critters
+        .iter()
+        .filter(|c| c.in_play() && !c.is_wall());
     let (mut fast, mut all) = (0, 0);
     for c in disks {
         fast += usize::from(displacement(state, c, dt) > limit);
@@ -122,7 +125,7 @@ pub(crate) fn step<V: Vector>(
     let clock = std::time::Instant::now();
     let dv = state.gravity * dt;
     for c in state.critters.iter_mut_moving() {
-        if c.alive && !c.fixed && !c.is_wall() {
+        if c.in_play() && !c.fixed && !c.is_wall() {
             c.vel += dv;
         }
     }
@@ -214,7 +217,7 @@ fn tail_substeps<V: Vector>(state: &State<V>, rest: f64, limit: f64, kicked: boo
     let g = state.gravity;
     let mut fastest: f64 = 0.0;
     for c in state.critters.iter() {
-        if c.alive && !c.is_wall() {
+        if c.in_play() && !c.is_wall() {
             // The same arithmetic as `finish_in_substeps`, without changing the velocities.
             let v = if kicked && !c.fixed {
                 c.vel - g * rest
@@ -245,7 +248,7 @@ pub(crate) fn finish_in_substeps<V: Vector>(
     let g = state.gravity;
     let mut fastest: f64 = 0.0;
     for c in state.critters.iter_mut_moving() {
-        if c.alive && !c.is_wall() {
+        if c.in_play() && !c.is_wall() {
             if kicked && !c.fixed {
                 c.vel -= g * rest;
             }

@@ -231,6 +231,7 @@ fn restore_world<V: Vector>(w: &mut World<V>, s: &StateMsg) -> Result<(), String
             fixed,
             alive: s.alive[i],
             wall: false,
+            aside: false,
             traits: Arc::new(Traits {
                 kind,
                 mass,

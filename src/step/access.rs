@@ -167,14 +167,14 @@ impl<V: Vector> Access<'_, V> {
     pub fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
         self.critters
             .iter()
-            .filter(|c| c.alive && self.kinds.is_kind(c.kind(), kind))
+            .filter(|c| c.in_play() && self.kinds.is_kind(c.kind(), kind))
             .map(|c| c.id)
             .collect()
     }
     /// Kills critter `id`: it takes no further collisions and is removed after the step.
     pub fn die(&mut self, id: CritterId) {
         if let Some(c) = self.critters.get_mut(id) {
-            if c.alive {
+            if c.in_play() {
                 c.alive = false;
                 self.pending.deaths.push(id);
             }
@@ -183,7 +183,7 @@ impl<V: Vector> Access<'_, V> {
     /// Pop's `damage`: lowers health by `amount`; at or below zero the critter dies.
     pub fn damage(&mut self, id: CritterId, amount: f64) {
         let dead = match self.critters.get_mut(id) {
-            Some(c) if c.alive => {
+            Some(c) if c.in_play() => {
                 c.traits_mut().health -= amount;
                 self.events.damages.push((id, amount));
                 c.health() <= 0.0

@@ -40,7 +40,7 @@ pub(crate) fn run_watching<V: Vector, const WATCH: bool>(
     let dv = g * h;
     // The squared distance moved when farther than the radius, else 0.
     let step = move |i: usize, c: &mut Critter<V>| -> f64 {
-        if !c.alive || c.is_wall() || still.get(i).copied().unwrap_or(false) {
+        if !c.in_play() || c.is_wall() || still.get(i).copied().unwrap_or(false) {
             return 0.0;
         }
         if !c.fixed {

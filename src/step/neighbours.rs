@@ -538,7 +538,7 @@ impl<V: Vector> Grid<V> {
 #[inline]
 fn passes<V: Vector>(at: Scope<'_, V>, item: &Item<V>, filter: Filter) -> bool {
     debug_assert!(filter.kind.is_none_or(|k| at.kinds.is_kind(item.kind, k)));
-    filter.exclude != Some(item.id) && at.critters.get(item.id).is_some_and(|c| c.alive)
+    filter.exclude != Some(item.id) && at.critters.get(item.id).is_some_and(|c| c.in_play())
 }
 
 #[cfg(test)]

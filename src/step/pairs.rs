@@ -143,7 +143,7 @@ impl<V: Vector> Pairs<V> {
             for c in state
                 .critters
                 .iter_mut_moving()
-                .filter(|c| c.alive && c.class == CLASS_UNSET)
+                .filter(|c| c.in_play() && c.class == CLASS_UNSET)
             {
                 c.class = state.rules.class_of(&state.kinds, c);
             }
@@ -167,7 +167,7 @@ impl<V: Vector> Pairs<V> {
                     state
                         .critters
                         .slot(s)
-                        .is_some_and(|c| c.alive && c.is_wall())
+                        .is_some_and(|c| c.in_play() && c.is_wall())
                 }) {
                     walls += 1;
                     let i = slot as usize;
@@ -478,7 +478,7 @@ impl<V: Vector> ChunkCheck<'_, V> {
     #[inline]
     pub(crate) fn moved(&mut self, i: usize, c: &Critter<V>) {
         self.seen = self.seen.and(CritterSurvey::of(c));
-        if c.alive && c.is_wall() {
+        if c.in_play() && c.is_wall() {
             self.walls += 1;
         } else {
             self.note(i, broad_object(c, i as u32, 0.0).as_ref());
@@ -522,8 +522,8 @@ impl CritterSurvey {
     #[inline]
     fn of<V: Vector>(c: &Critter<V>) -> CritterSurvey {
         CritterSurvey {
-            unset: c.alive && c.class == CLASS_UNSET,
-            largest_radius: if c.alive && !c.is_wall() {
+            unset: c.in_play() && c.class == CLASS_UNSET,
+            largest_radius: if c.in_play() && !c.is_wall() {
                 c.radius
             } else {
                 0.0
@@ -547,7 +547,7 @@ pub(crate) fn broad_object<V: Vector>(
     slot: u32,
     wall_pad: f64,
 ) -> Option<BroadObject<V>> {
-    if !c.alive {
+    if !c.in_play() {
         return None;
     }
     let mut o = BroadObject {
@@ -615,7 +615,7 @@ impl<V: Vector> Objects<V> for SlotObjects<'_, V> {
     #[inline]
     fn step(&self, i: usize) -> V {
         match self.slots.get(i) {
-            Some(Some(c)) if c.alive && !c.fixed && !c.is_wall() => c.vel * self.dt,
+            Some(Some(c)) if c.in_play() && !c.fixed && !c.is_wall() => c.vel * self.dt,
             _ => V::zero(),
         }
     }

@@ -61,6 +61,7 @@ impl<V: Vector> State<V> {
             fixed: true,
             alive: true,
             wall: true,
+            aside: false,
             traits: Arc::new(Traits {
                 kind: WALL,
                 mass: f64::INFINITY,
@@ -314,6 +315,7 @@ impl<V: Vector> State<V> {
             fixed,
             alive: true,
             wall: false,
+            aside: false,
             traits: Arc::new(Traits {
                 kind: kind_id,
                 mass,

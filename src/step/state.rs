@@ -114,7 +114,7 @@ impl<V: Vector> State<V> {
             for c in self
                 .critters
                 .iter_mut_moving()
-                .filter(|c| c.alive && !c.is_wall())
+                .filter(|c| c.in_play() && !c.is_wall())
             {
                 c.pos = topo.wrap_position(c.pos);
             }
@@ -132,8 +132,8 @@ impl<V: Vector> State<V> {
         let (Some(a), Some(b)) = (self.critters.slot(first), self.critters.slot(second)) else {
             return Ok(None);
         };
-        if !a.alive
-            || !b.alive
+        if !a.in_play()
+            || !b.in_play()
             || crate::default_response::contact_between(&self.topo, a, b).is_none()
         {
             return Ok(None);
@@ -151,7 +151,7 @@ impl<V: Vector> State<V> {
         let (Some(c), Some(a)) = (self.critters.slot(caller), self.critters.slot(arg)) else {
             return Ok(false);
         };
-        if !c.alive || !a.alive {
+        if !c.in_play() || !a.in_play() {
             return Ok(false);
         }
         let (kind, id, step) = (c.kind(), c.id, self.step_count);

@@ -115,7 +115,8 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
     let mut now: Vec<_> = state.touch.now.drain().collect();
     now.sort_unstable_by_key(|(pair, _)| *pair);
     let open = std::mem::take(&mut state.touch.open);
-    let alive = |state: &State<V>, id: CritterId| state.critters.get(id).is_some_and(|c| c.alive);
+    let alive =
+        |state: &State<V>, id: CritterId| state.critters.get(id).is_some_and(|c| c.in_play());
     let mut kept = Vec::with_capacity(open.len() + now.len());
     let mut ended = Vec::new();
     let mut begun = Vec::new();
@@ -139,7 +140,7 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
             else {
                 continue; // removed: its spells were ended then
             };
-            if !a.alive || !b.alive || crate::default_response::touches(&state.topo, a, b) {
+            if !a.in_play() || !b.in_play() || crate::default_response::touches(&state.topo, a, b) {
                 // The dying end their spells in the lifecycle; a pair the method did not
                 // report (sleepers) but that still touches goes on.
                 kept.push(pair);

@@ -21,7 +21,7 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>, span: Span) -> Result<(), Err
         let Some(c) = state.critters.slot(slot) else {
             continue;
         };
-        if !c.alive || !state.kinds.get(c.kind()).has_update {
+        if !c.in_play() || !state.kinds.get(c.kind()).has_update {
             continue;
         }
         let (kind, id) = (c.kind(), c.id);

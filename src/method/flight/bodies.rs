@@ -26,7 +26,7 @@ pub(super) struct Body<V: Vector> {
 pub(super) struct Status {
     /// Accelerates with the flight's gravity (free disks).
     pub(super) free: bool,
-    pub(super) alive: bool,
+    pub(super) in_play: bool,
     pub(super) wall: bool,
     /// The critter's rule class (pair rules are looked up by class).
     pub(super) class: u32,
@@ -53,13 +53,13 @@ pub(super) fn refresh_body<V: Vector>(state: &State<V>, sc: &mut Scratch<V>, a: 
         Some(c) => {
             body.pos = c.pos;
             body.vel = c.vel;
-            body.radius = if c.alive && !c.is_wall() {
+            body.radius = if c.in_play() && !c.is_wall() {
                 c.radius
             } else {
                 f64::NAN
             };
             status.free = !c.fixed && !c.is_wall();
-            status.alive = c.alive;
+            status.in_play = c.in_play();
             status.wall = c.is_wall();
             status.class = c.class;
         }
@@ -115,7 +115,7 @@ pub(super) fn motion_at<V: Vector>(sc: &Scratch<V>, a: u32, t: f64) -> Motion<V>
 /// Brings critter `a` (and its body) to time `t` along its flight.
 pub(super) fn advance<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: u32, t: f64) {
     let s = sc.status[a as usize];
-    if !s.alive || s.wall {
+    if !s.in_play || s.wall {
         return;
     }
     let Motion { pos, vel, .. } = motion_at(sc, a, t);

@@ -340,7 +340,7 @@ pub(super) fn relocate<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: 
     if sc.shells {
         // Listed again when it died, grew, or was moved out of its shell.
         let stays = state.critters.slot(a).is_some_and(|c| {
-            c.alive
+            c.in_play()
                 && c.radius == sc.body[a as usize].radius
                 && state
                     .topo
@@ -358,7 +358,7 @@ pub(super) fn relocate<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, a: 
     let Some(c) = state.critters.slot(a) else {
         return;
     };
-    if !c.alive {
+    if !c.in_play() {
         sc.cells.remove(old, a);
         return;
     }

@@ -93,15 +93,15 @@ pub(super) enum Validity {
 }
 
 pub(super) fn validity<V: Vector>(sc: &Scratch<V>, ev: &Event) -> Validity {
-    let alive = |x: u32| sc.status[x as usize].alive;
-    if !alive(ev.owner) || sc.status[ev.owner as usize].changes != ev.owner_changes {
+    let in_play = |x: u32| sc.status[x as usize].in_play;
+    if !in_play(ev.owner) || sc.status[ev.owner as usize].changes != ev.owner_changes {
         return Validity::Stale;
     }
     let ok = match ev.kind {
         EventKind::Pair => {
-            alive(ev.other) && sc.status[ev.other as usize].changes == ev.other_changes
+            in_play(ev.other) && sc.status[ev.other as usize].changes == ev.other_changes
         }
-        EventKind::Wall => alive(ev.other),
+        EventKind::Wall => in_play(ev.other),
         _ => true,
     };
     if ok {

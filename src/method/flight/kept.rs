@@ -65,15 +65,15 @@ fn against<V: Vector>(
     start: f64,
 ) -> Against {
     let Some(c) = slot else {
-        return if status.alive {
+        return if status.in_play {
             Against::Lost
         } else {
             Against::NoDisk
         };
     };
-    let same = c.alive == status.alive
+    let same = c.in_play() == status.in_play
         && c.is_wall() == status.wall
-        && (!c.alive
+        && (!c.in_play()
             || if c.is_wall() {
                 c.pos == body.pos
             } else {
@@ -81,7 +81,7 @@ fn against<V: Vector>(
             });
     if !same {
         Against::Lost
-    } else if !c.alive || c.is_wall() {
+    } else if !c.in_play() || c.is_wall() {
         Against::NoDisk
     } else if c.pos != body.pos || c.vel != body.vel || body.t != start {
         Against::Moved
@@ -105,7 +105,7 @@ pub(super) fn end_flight<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, e
     for a in 0..n {
         let s = sc.status[a];
         // As `advance` (a line needs no acceleration, the most common case).
-        let motion = match (s.alive && !s.wall, straight) {
+        let motion = match (s.in_play && !s.wall, straight) {
             (false, _) => None,
             (true, true) => {
                 let b = &sc.body[a];
@@ -128,7 +128,7 @@ pub(super) fn end_flight<V: Vector>(state: &mut State<V>, sc: &mut Scratch<V>, e
                 c.pos = pos;
                 c.vel = vel;
             }
-            if c.alive && !c.is_wall() {
+            if c.in_play() && !c.is_wall() {
                 c.pos = if topo.wraps() {
                     topo.wrap_position(c.pos)
                 } else if topo.clear_of_edges(c.pos, c.radius) {

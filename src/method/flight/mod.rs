@@ -482,7 +482,7 @@ fn fly<V: Vector>(
                     refresh_body(state, sc, x);
                 }
                 if let (Some(x), Some(y)) = (state.critters.slot(a), state.critters.slot(b)) {
-                    if x.alive && y.alive {
+                    if x.in_play() && y.in_play() {
                         if let Some(c) = crate::default_response::contact_between(&state.topo, x, y)
                         {
                             if c.depth > SKIN * x.radius.min(y.radius) * 4.0 {

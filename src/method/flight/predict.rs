@@ -35,7 +35,7 @@ pub(super) fn predict<V: Vector>(
     t: f64,
 ) -> Result<(), Error> {
     let me = sc.status[a as usize];
-    if !me.alive || me.wall {
+    if !me.in_play || me.wall {
         sc.queue.remove(a);
         return Ok(());
     }
@@ -132,7 +132,7 @@ pub(super) fn predict_after_crossing<V: Vector>(
     let home = sc.cell[a as usize] as usize;
     let kept = sc.earliest_contact[a as usize];
     let kept_valid = kept.is_none_or(|ev| matches!(validity(sc, &ev), Validity::Valid));
-    if !(sc.straight && kept_valid && interior::<V>(sc, a) && sc.status[a as usize].alive) {
+    if !(sc.straight && kept_valid && interior::<V>(sc, a) && sc.status[a as usize].in_play) {
         return predict(state, sc, a, t);
     }
     sc.predictions += 1;
@@ -351,7 +351,7 @@ fn predict_general<V: Vector>(
     sc.pair_tests += 1;
     let (body_a, body_b) = (sc.body[a as usize], sc.body[b as usize]);
     let status_b = sc.status[b as usize];
-    if !status_b.alive {
+    if !status_b.in_play {
         return Ok(());
     }
     let ahead = sc.horizon - t;

@@ -51,11 +51,11 @@ pub(super) fn setup<V: Vector>(
         if c.class == CLASS_UNSET {
             c.class = state.rules.class_of(&state.kinds, c);
         }
-        if c.alive && !c.is_wall() {
+        if c.in_play() && !c.is_wall() {
             rmax = rmax.max(c.radius);
             disks += 1;
         }
-        sc.has_walls |= c.alive && c.is_wall();
+        sc.has_walls |= c.in_play() && c.is_wall();
     }
     rmax = rmax.max(sc.grown_radius);
     sc.largest_radius = rmax;
@@ -161,7 +161,7 @@ pub(super) fn setup<V: Vector>(
     load.clear();
     load.resize(total, 0);
     for c in state.critters.iter() {
-        if c.alive && !c.is_wall() {
+        if c.in_play() && !c.is_wall() {
             let (k, cc) = cell_of(state, sc, c.pos);
             debug_assert_eq!(cell_coords(&dims, k), cc, "cell {k}'s coordinates");
             sc.cell[c.id.index as usize] = k as u32;
@@ -176,7 +176,7 @@ pub(super) fn setup<V: Vector>(
     sc.cell_walls
         .resize_with(if sc.has_walls { total } else { 0 }, Vec::new);
     for c in state.critters.iter() {
-        if !c.alive {
+        if !c.in_play() {
             continue;
         }
         match c.shape() {
@@ -287,7 +287,7 @@ fn near_a_wall<V: Vector>(state: &State<V>, sc: &Scratch<V>, a: u32, moves: f64)
                 continue;
             };
             let d = state.topo.delta(c.pos, body.pos);
-            if c.alive && contact_wall_ball(wall, d, body.radius + moves).is_some() {
+            if c.in_play() && contact_wall_ball(wall, d, body.radius + moves).is_some() {
                 return true;
             }
         }
