@@ -19,6 +19,7 @@ mod determinism;
 mod fuzz_recording;
 mod fuzz_scene;
 mod hook_calls;
+mod layers;
 mod lifecycle;
 mod locality;
 mod methods;

@@ -103,7 +103,7 @@ fn the_core_has_no_import_cycle_but_the_named_ones() {
         .collect();
     assert!(
         unexpected.is_empty(),
-        "import cycles not in tests/layers.rs's CYCLES (break them, or name one there with its \
+        "import cycles not in tests/integration/layers.rs's CYCLES (break them, or name one there with its \
          reason):\n{}",
         unexpected.join("\n")
     );
@@ -152,7 +152,9 @@ fn layer_of(file: &str) -> usize {
                 }
             })
         })
-        .unwrap_or_else(|| panic!("src/{file} is in no layer of tests/layers.rs: add it to one"))
+        .unwrap_or_else(|| {
+            panic!("src/{file} is in no layer of tests/integration/layers.rs: add it to one")
+        })
 }
 
 /// Which library file uses which, by path under `src/`.
@@ -325,7 +327,7 @@ fn test_files(sources: &BTreeMap<String, String>) -> BTreeSet<String> {
     let mut tests = BTreeSet::new();
     for (file, text) in sources {
         let dir = match file.rsplit_once('/') {
-            Some((d, name)) if name == "mod.rs" => format!("{d}/"),
+            Some((d, "mod.rs")) => format!("{d}/"),
             Some((d, name)) => format!("{d}/{}/", name.trim_end_matches(".rs")),
             None if file == "lib.rs" => String::new(),
             None => format!("{}/", file.trim_end_matches(".rs")),
@@ -432,8 +434,8 @@ fn code_only(text: &str) -> String {
             i += 1;
         } else if b[i] == b'\'' {
             // A character literal ('x', '\n', '{'), not a lifetime ('a).
-            if rest.starts_with("'\\") {
-                i += 2 + rest[2..].find('\'').map_or(0, |e| e + 1);
+            if let Some(escaped) = rest.strip_prefix("'\\") {
+                i += 2 + escaped.find('\'').map_or(0, |e| e + 1);
             } else if let Some(c) = rest[1..].chars().next() {
                 let after = 1 + c.len_utf8();
                 if rest[after..].starts_with('\'') {
