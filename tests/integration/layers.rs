@@ -338,7 +338,10 @@ fn test_files(sources: &BTreeMap<String, String>) -> BTreeSet<String> {
         };
         let lines: Vec<&str> = text.lines().map(str::trim).collect();
         for (i, line) in lines.iter().enumerate() {
-            let Some(name) = line.strip_prefix("mod ").and_then(|r| r.strip_suffix(';')) else {
+            let declared = ["mod ", "pub mod ", "pub(crate) mod ", "pub(super) mod "]
+                .iter()
+                .find_map(|v| line.strip_prefix(v));
+            let Some(name) = declared.and_then(|r| r.strip_suffix(';')) else {
                 continue;
             };
             let attrs: Vec<&str> = lines[..i]
