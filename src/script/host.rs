@@ -10,7 +10,7 @@
 //!   or a scene's world during `on_step`, as a pointer whose lifetime is erased and which a
 //!   guard takes back before the borrow it came from ends.
 //!
-//! Script functions reach the target through [`with_env!`], one short-lived `&mut dyn Env` at a
+//! Script functions reach the target through [`with_env!`], one short-lived [`Env`] at a
 //! time: while one lives, the target is marked busy, so a second is never derived beside it.
 //! Every pointer into the world is derived from one place (the host's scene, or the `&mut` lent
 //! to `enter`) at the moment of use and dropped after it; none is kept across another `&mut`.
@@ -20,43 +20,47 @@ use super::env::Env;
 use super::{Extension, Runtime};
 use crate::error::ScriptError;
 use crate::scenes::{AnyWorld, Scene};
+use crate::step::access::Access;
 use crate::vector::Vector;
+use crate::world::World;
 use glam::{DVec2, DVec3};
 use std::cell::{Cell, RefCell, RefMut};
 use std::rc::{Rc, Weak};
 
-/// An environment lent by [`Host::enter`], its lifetime erased.
+/// What scripts act on, its lifetime erased: an environment lent by [`Host::enter`], or the
+/// host's own scene's world.
 #[derive(Clone, Copy)]
 pub(crate) enum EnvPtr {
-    D2(*mut (dyn Env<DVec2> + 'static)),
-    D3(*mut (dyn Env<DVec3> + 'static)),
+    D2(*mut Env<'static, DVec2>),
+    D3(*mut Env<'static, DVec3>),
+    World2(*mut World<DVec2>),
+    World3(*mut World<DVec3>),
 }
 
 /// A dimension scripts can run in.
 pub(crate) trait Dim: Vector {
-    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr;
+    fn env_ptr(env: *mut Env<'static, Self>) -> EnvPtr;
 }
 
 impl Dim for DVec2 {
-    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr {
+    fn env_ptr(env: *mut Env<'static, Self>) -> EnvPtr {
         EnvPtr::D2(env)
     }
 }
 
 impl Dim for DVec3 {
-    fn env_ptr(env: *mut (dyn Env<Self> + 'static)) -> EnvPtr {
+    fn env_ptr(env: *mut Env<'static, Self>) -> EnvPtr {
         EnvPtr::D3(env)
     }
 }
 
 /// The pointer of `env`, its lifetime erased; see [`Host::enter`] and [`Host::access`] for how
 /// long it is used.
-fn erase<V: Dim>(env: &mut (dyn Env<V> + '_)) -> EnvPtr {
-    let short: *mut (dyn Env<V> + '_) = env;
-    // SAFETY: only the trait object's lifetime bound changes, not the pointer or its vtable.
-    // The two callers dereference the result only while the borrow it came from is live.
-    let erased: *mut (dyn Env<V> + 'static) = unsafe { std::mem::transmute(short) };
-    V::env_ptr(erased)
+fn erase<V: Dim>(env: &mut Env<'_, V>) -> EnvPtr {
+    // Only the lifetime parameter changes, not the pointer. The callers dereference the result
+    // only while the borrow it came from is live.
+    let short: *mut Env<'_, V> = env;
+    V::env_ptr(short.cast::<Env<'static, V>>())
 }
 
 /// What running scripts act on.
@@ -169,11 +173,16 @@ impl Host {
 
     /// Runs `f` with scripts acting on `env`; the previous target is restored afterwards, also
     /// when `f` unwinds.
-    pub fn enter<V: Dim, R>(&self, env: &mut dyn Env<V>, f: impl FnOnce() -> R) -> R {
+    pub fn enter<V: Dim, R>(&self, env: &mut Env<'_, V>, f: impl FnOnce() -> R) -> R {
         // The pointer lives in the target only while `f` runs: `_restore` removes it before
         // `env`'s borrow ends, and nothing else uses `env` meanwhile (it is lent to this call).
         let _restore = self.aim(Target::Entered(erase(env)));
         f()
+    }
+
+    /// Runs `f` with scripts acting through a hook's `access` (inside a step).
+    pub fn enter_hook<V: Dim, R>(&self, access: &mut Access<'_, V>, f: impl FnOnce() -> R) -> R {
+        self.enter(&mut Env::Hook(access.reborrow()), f)
     }
 
     /// True when the host holds a scene (lent out or not).
@@ -219,8 +228,8 @@ impl Host {
                     return Err(no_world());
                 };
                 let ptr = match &mut scene.world {
-                    AnyWorld::D2(w) => erase::<DVec2>(w),
-                    AnyWorld::D3(w) => erase::<DVec3>(w),
+                    AnyWorld::D2(w) => EnvPtr::World2(w),
+                    AnyWorld::D3(w) => EnvPtr::World3(w),
                 };
                 (ptr, Some(slot))
             }
@@ -282,8 +291,8 @@ pub(crate) struct EnvAccess<'h> {
 
 /// The environment of one script function, in the running world's dimension.
 pub(crate) enum EnvRef<'a> {
-    D2(&'a mut dyn Env<DVec2>),
-    D3(&'a mut dyn Env<DVec3>),
+    D2(Env<'a, DVec2>),
+    D3(Env<'a, DVec3>),
 }
 
 impl EnvAccess<'_> {
@@ -297,13 +306,15 @@ impl EnvAccess<'_> {
         // run from here (a spawn's `init`) is lent a pointer derived from the reference returned
         // here, through its own `enter`, so the two nest as reborrows do.
         match self.ptr {
-            EnvPtr::D2(p) => EnvRef::D2(unsafe { &mut *p }),
-            EnvPtr::D3(p) => EnvRef::D3(unsafe { &mut *p }),
+            EnvPtr::D2(p) => EnvRef::D2(unsafe { (*p).reborrow() }),
+            EnvPtr::D3(p) => EnvRef::D3(unsafe { (*p).reborrow() }),
+            EnvPtr::World2(p) => EnvRef::D2(Env::World(unsafe { &mut *p })),
+            EnvPtr::World3(p) => EnvRef::D3(Env::World(unsafe { &mut *p })),
         }
     }
 }
 
-/// Runs `$body` with `$env` bound to the running script's environment as `&mut dyn Env<V>`,
+/// Runs `$body` with `$env` bound to the running script's environment as `&mut Env<'_, V>`,
 /// for whichever dimension the world has (the body is compiled once for each). Evaluates to an
 /// error when no world is reachable.
 macro_rules! with_env {
@@ -313,8 +324,14 @@ macro_rules! with_env {
         match unsafe { host.access() } {
             Err(e) => Err(e),
             Ok(mut access) => match access.env() {
-                $crate::script::host::EnvRef::D2($env) => $body,
-                $crate::script::host::EnvRef::D3($env) => $body,
+                $crate::script::host::EnvRef::D2(mut env) => {
+                    let $env = &mut env;
+                    $body
+                }
+                $crate::script::host::EnvRef::D3(mut env) => {
+                    let $env = &mut env;
+                    $body
+                }
             },
         }
     }};

@@ -3,19 +3,16 @@
 //! hook (see [`parent_hook`]).
 
 use super::api::{fail, rule_code, rule_of_code, CritterRef, Res, ScriptContact};
-use super::env::Env;
+use super::env::{Env, PairView};
 use super::errors::eval_error;
 use super::host::{with_env, Dim, Host};
 use super::kind_file::{HookFn, ScriptKindDef};
 use super::Runtime;
-use crate::border::Topology;
-use crate::critter::{Critter, CritterId, CritterSpec};
+use crate::critter::CritterId;
 use crate::error::{Error, ScriptError};
-use crate::kind::{CollideRule, KindHooks, KindId, KindSet, RuleCtx};
+use crate::kind::{CollideRule, KindHooks, RuleCtx};
 use crate::rng::Rng;
 use crate::step::access::{CollideCtx, HookContact, UpdateCtx};
-use crate::vector::Vector;
-use crate::world::World;
 use rhai::grain::Vm;
 use rhai::{CallFnOptions, Dynamic, Scope, INT};
 use std::cell::Cell;
@@ -214,13 +211,14 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
         let Some(f) = self.def.hook("collides_with") else {
             return Ok(crate::kind::default_collides_with(ctx.me, ctx.other));
         };
-        let mut view = PairView {
+        let mut rng = Rng::new(0);
+        let mut view = Env::Pair(PairView {
             a: ctx.me,
             b: ctx.other,
             kinds: ctx.kinds,
             topo: ctx.topo,
-            rng: Rng::new(0),
-        };
+            rng: &mut rng,
+        });
         let (me, other) = (ctx.me.id(), ctx.other.id());
         let frame = self.frame("collides_with", f, me, Some(other));
         let args = (CritterRef(me), CritterRef(other));
@@ -246,7 +244,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             _ => ScriptContact::default(),
         };
         let first = ctx.first;
-        self.rt.host.enter::<V, _>(&mut **ctx, || {
+        self.rt.host.enter_hook::<V, _>(&mut **ctx, || {
             self.run_collide(f, me, other, contact, first)
         })
     }
@@ -265,7 +263,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             let frame = self.frame("update", f, me, None);
             self.rt
                 .host
-                .enter::<V, _>(&mut **ctx, || {
+                .enter_hook::<V, _>(&mut **ctx, || {
                     self.call("update", f, frame, (CritterRef(me), dt))
                 })
                 .map(drop)?;
@@ -283,7 +281,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             let frame = self.frame("init", f, me, None);
             self.rt
                 .host
-                .enter::<V, _>(&mut **ctx, || {
+                .enter_hook::<V, _>(&mut **ctx, || {
                     self.call("init", f, frame, (CritterRef(me),))
                 })
                 .map(drop)?;
@@ -315,7 +313,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             );
             self.rt
                 .host
-                .enter::<V, _>(&mut **ctx, || self.call("touch_begin", f, frame, args))
+                .enter_hook::<V, _>(&mut **ctx, || self.call("touch_begin", f, frame, args))
                 .map(drop)?;
         }
         Ok(())
@@ -328,7 +326,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             let args = (CritterRef(me), CritterRef(other));
             self.rt
                 .host
-                .enter::<V, _>(&mut **ctx, || self.call("touch_end", f, frame, args))
+                .enter_hook::<V, _>(&mut **ctx, || self.call("touch_end", f, frame, args))
                 .map(drop)?;
         }
         Ok(())
@@ -344,7 +342,7 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
             let frame = self.frame("on_death", f, me, None);
             self.rt
                 .host
-                .enter::<V, _>(&mut **ctx, || {
+                .enter_hook::<V, _>(&mut **ctx, || {
                     self.call("on_death", f, frame, (CritterRef(me),))
                 })
                 .map(drop)?;
@@ -492,67 +490,4 @@ pub(crate) fn parent_plain(
         None => kind.call(hook, &f, inner, (CritterRef(me),)),
     };
     got.map(drop).map_err(|e| host.carry(e))
-}
-
-/// What `collides_with` may see: the two critters, read-only.
-struct PairView<'a, V: Vector> {
-    a: &'a Critter<V>,
-    b: &'a Critter<V>,
-    kinds: &'a KindSet<V>,
-    topo: &'a Topology<V>,
-    rng: Rng,
-}
-
-impl<V: Vector> Env<V> for PairView<'_, V> {
-    fn critter(&self, id: CritterId) -> Option<&Critter<V>> {
-        [self.a, self.b].into_iter().find(|c| c.id() == id)
-    }
-    fn critter_mut(&mut self, _id: CritterId) -> Option<&mut Critter<V>> {
-        None
-    }
-    fn kinds(&self) -> &KindSet<V> {
-        self.kinds
-    }
-    fn topology(&self) -> &Topology<V> {
-        self.topo
-    }
-    fn step_count(&self) -> u64 {
-        0
-    }
-    fn time(&self) -> f64 {
-        0.0
-    }
-    fn dt(&self) -> f64 {
-        0.0
-    }
-    fn rng(&mut self) -> &mut Rng {
-        // collides_with must not draw numbers: its answer may be cached.
-        &mut self.rng
-    }
-    fn die(&mut self, _id: CritterId) {}
-    fn damage(&mut self, _id: CritterId, _amount: f64) {}
-    fn spawn(&mut self, _spec: CritterSpec<V>) -> Result<Option<CritterId>, Error> {
-        Err(Error::InvalidKind {
-            kind: "collides_with".into(),
-            reason: "collides_with only answers how two critters meet; spawn in collide or update"
-                .into(),
-        })
-    }
-    fn log(&mut self, _line: String) {}
-    fn critters_of(&self, _kind: KindId) -> Vec<CritterId> {
-        Vec::new()
-    }
-    fn collide_default(
-        &mut self,
-        _caller: CritterId,
-        _arg: CritterId,
-    ) -> Result<Option<f64>, String> {
-        Err("collide_default belongs in collide, not collides_with".into())
-    }
-    fn age(&self, _id: CritterId) -> Option<f64> {
-        None
-    }
-    fn world(&mut self) -> Option<&mut World<V>> {
-        None
-    }
 }

@@ -15,21 +15,6 @@ use crate::error::Error;
 use crate::world::World;
 use std::rc::Rc;
 
-/// Calls whose string-literal arguments are kind names.
-pub(crate) const KIND_CALLS: &[&str] = &[
-    "spawn",
-    "is_kind",
-    "count",
-    "critters_of",
-    "nearby",
-    "nearest",
-    "load_kind",
-    "scatter",
-    "row",
-    "ring",
-    "grid",
-];
-
 /// The kinds the engine has without a file.
 pub(crate) const NATIVE_KINDS: &[&str] = &["ball", "wall"];
 
@@ -139,9 +124,10 @@ fn tokens(text: &str) -> Vec<(Tok, usize, usize)> {
 }
 
 /// The kind names `text` gives as string literals: `extends "name"`, and every string literal
-/// that is a whole argument of one of [`KIND_CALLS`] (so `spawn("a", #{ tag: "b" })` names `a`
-/// only, and `nearby(5.0, "prey")` names `prey`). In source order.
-pub(crate) fn find(text: &str) -> Vec<KindRef> {
+/// that is a whole argument of one of `calls`, the functions registered as taking kind names
+/// (`Runtime::kind_calls`): so `spawn("a", #{ tag: "b" })` names `a` only, and
+/// `nearby(5.0, "prey")` names `prey`. In source order.
+pub(crate) fn find(text: &str, calls: &[&'static str]) -> Vec<KindRef> {
     let toks = tokens(text);
     let mut out = Vec::new();
     for (i, (tok, _, _)) in toks.iter().enumerate() {
@@ -157,7 +143,7 @@ pub(crate) fn find(text: &str) -> Vec<KindRef> {
             }
             continue;
         }
-        let Some(call) = KIND_CALLS.iter().find(|k| **k == name.as_str()) else {
+        let Some(call) = calls.iter().find(|k| **k == name.as_str()) else {
             continue;
         };
         if !matches!(toks.get(i + 1), Some((Tok::Open('('), _, _))) {
@@ -224,7 +210,7 @@ pub(crate) fn load_named_in<V: Dim>(
     world: &mut World<V>,
     text: &str,
 ) -> Result<(), Error> {
-    for r in find(text) {
+    for r in find(text, &rt.kind_calls) {
         if NATIVE_KINDS.contains(&r.name.as_str()) || world.kinds().id(&r.name).is_ok() {
             continue;
         }
@@ -271,7 +257,8 @@ mod tests {
     use super::*;
 
     fn names(text: &str) -> Vec<(String, usize, usize)> {
-        find(text)
+        let rt = Runtime::new(&crate::script::ScriptOptions::default(), None);
+        find(text, &rt.kind_calls)
             .into_iter()
             .map(|r| (r.name, r.line, r.column))
             .collect()

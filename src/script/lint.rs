@@ -185,7 +185,7 @@ fn hook_warnings(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Prob
 /// Warnings for kind names in string literals that name no kind.
 fn kind_name_warnings(rt: &Runtime, file: &str, text: &str) -> Vec<Problem> {
     let known = rt.known_kind_names();
-    kind_refs::find(text)
+    kind_refs::find(text, &rt.kind_calls)
         .into_iter()
         .filter(|r| !known.contains(&r.name))
         .map(|r| {

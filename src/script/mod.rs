@@ -98,6 +98,8 @@ pub(crate) struct Runtime {
     pub host: Rc<Host>,
     /// Folders searched for `name.rhai` when a kind is asked for by name.
     pub kind_dirs: Vec<PathBuf>,
+    /// The script functions whose string arguments name kinds (see [`api::Api::kind_func`]).
+    pub(crate) kind_calls: Vec<&'static str>,
     /// Script kinds by name.
     pub kinds: RefCell<BTreeMap<String, Rc<kind_file::ScriptKindDef>>>,
     /// Every file loaded, in load order.
@@ -116,8 +118,8 @@ pub(crate) struct Runtime {
 /// What a layer above scripts adds to a runtime (the script test runner's API): functions on
 /// its engine, and a word each time a script puts a scene into the runtime's host.
 pub(crate) trait Extension {
-    /// Registers the functions; they reach the world through `host`.
-    fn register(self: Rc<Self>, engine: &mut Engine, host: &Rc<Host>);
+    /// Registers the functions (each reaches the world through the host [`api::Api`] hands it).
+    fn register(self: Rc<Self>, api: &mut api::Api);
     /// A script has just made the host's scene (`world(#{ ... })`) or loaded one.
     fn scene_made(&self, host: &Host) -> Res<()>;
 }
@@ -150,8 +152,10 @@ impl Runtime {
             host.seed_override.set(options.seed);
             let profiler = Rc::new(crate::profile::Profiler::default());
             profiler.set_on(options.profile);
+            let (engine, kind_calls) = api::build_engine(&host, &options.limits);
             Runtime {
-                engine: api::build_engine(&host, &options.limits),
+                engine,
+                kind_calls,
                 host,
                 kind_dirs,
                 kinds: RefCell::new(BTreeMap::new()),

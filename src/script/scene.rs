@@ -3,6 +3,7 @@
 //! its world are in [`super::api`].
 
 use super::api::WorldRef;
+use super::env::Env;
 use super::errors::{eval_error, fn_location};
 use super::{read_script, Runtime, ScriptOptions, SourceFile};
 use crate::error::{Error, ScriptError};
@@ -232,8 +233,8 @@ impl OnStep {
             AnyWorld::D3(w) => w.step_count(),
         };
         let result = self.rt.profiler.time("scene", "on_step", || match world {
-            AnyWorld::D2(w) => self.rt.host.enter::<DVec2, _>(w, run),
-            AnyWorld::D3(w) => self.rt.host.enter::<DVec3, _>(w, run),
+            AnyWorld::D2(w) => self.rt.host.enter::<DVec2, _>(&mut Env::World(w), run),
+            AnyWorld::D3(w) => self.rt.host.enter::<DVec3, _>(&mut Env::World(w), run),
         });
         result.map(drop).map_err(|e| {
             let mut err = eval_error(

@@ -1,13 +1,12 @@
 //! What a kind's hooks see: the critters involved, the rest of the world read and write, and
 //! queues for structural changes (deaths, spawns) that take effect after the step.
 
-use super::births::Births;
-use super::events::{CollisionEvent, StepEvents};
-use super::neighbours::{Filter, Neighbours, Scope};
-use super::pending::{OnOverlap, Pending, PendingSpawn, SpawnOrigin};
+use super::events::CollisionEvent;
+use super::neighbours::Filter;
+use super::pending::{OnOverlap, PendingSpawn, SpawnOrigin};
+use super::state::State;
 use crate::border::Topology;
 use crate::critter::{Critter, CritterId, CritterSpec, Props};
-use crate::critter_set::CritterSet;
 use crate::default_response::{self, Hit};
 use crate::kind::{KindId, KindSet};
 use crate::rng::Rng;
@@ -60,31 +59,27 @@ impl<V: Vector> HookContact<V> {
     }
 }
 
-/// Read-write access to the world from inside a hook.
+/// Read-write access to the world from inside a hook: the step's state, through what its
+/// methods allow.
 pub struct Access<'a, V: Vector> {
-    pub(crate) critters: &'a mut CritterSet<V>,
-    pub(crate) kinds: &'a KindSet<V>,
-    pub(crate) topo: &'a Topology<V>,
-    pub(crate) pending: &'a mut Pending<V>,
-    pub(crate) events: &'a mut StepEvents<V>,
-    pub(crate) vars: &'a mut Props,
-    pub(crate) births: &'a Births,
-    pub(crate) rng: &'a mut Rng,
-    pub(crate) neighbours: &'a mut Neighbours<V>,
-    pub(crate) step: u64,
-    pub(crate) time: f64,
-    pub(crate) dt: f64,
+    pub(crate) state: &'a mut State<V>,
 }
 
 impl<V: Vector> Access<'_, V> {
+    /// The same access, borrowed for a shorter while.
+    pub(crate) fn reborrow(&mut self) -> Access<'_, V> {
+        Access {
+            state: &mut *self.state,
+        }
+    }
     /// The critter `id`, if alive or dying this step.
     pub fn get(&self, id: CritterId) -> Option<&Critter<V>> {
-        self.critters.get(id)
+        self.state.critters.get(id)
     }
     /// The critter `id`, mutably.
     pub fn get_mut(&mut self, id: CritterId) -> Option<&mut Critter<V>> {
-        self.neighbours.moved(id);
-        self.critters.get_mut(id)
+        self.state.neighbours.moved(id);
+        self.state.critters.get_mut(id)
     }
     /// Live critters other than walls whose centres lie within `r` of `centre` (through the
     /// border when it wraps), of `kind` or a kind extending it when given, leaving out
@@ -96,13 +91,8 @@ impl<V: Vector> Access<'_, V> {
         kind: Option<KindId>,
         exclude: Option<CritterId>,
     ) -> Vec<CritterId> {
-        let at = Scope {
-            critters: self.critters,
-            kinds: self.kinds,
-            topo: self.topo,
-        };
-        self.neighbours
-            .nearby(at, centre, r, Filter { kind, exclude })
+        let (grid, at) = self.state.scope();
+        grid.nearby(at, centre, r, Filter { kind, exclude })
     }
     /// The live critter other than walls nearest to `centre`, of `kind` (or a kind extending
     /// it) when given, leaving out `exclude`; ties go to the lower id.
@@ -112,80 +102,81 @@ impl<V: Vector> Access<'_, V> {
         kind: Option<KindId>,
         exclude: Option<CritterId>,
     ) -> Option<CritterId> {
-        let at = Scope {
-            critters: self.critters,
-            kinds: self.kinds,
-            topo: self.topo,
-        };
-        self.neighbours
-            .nearest(at, centre, Filter { kind, exclude })
+        let (grid, at) = self.state.scope();
+        grid.nearest(at, centre, Filter { kind, exclude })
     }
     /// The kinds of the world.
     pub fn kinds(&self) -> &KindSet<V> {
-        self.kinds
+        &self.state.kinds
     }
     /// The world box and border.
     pub fn topology(&self) -> &Topology<V> {
-        self.topo
+        &self.state.topo
     }
     /// Steps completed before this one.
     pub fn step(&self) -> u64 {
-        self.step
+        self.state.step_count
     }
     /// Simulated time at the start of this step.
     pub fn time(&self) -> f64 {
-        self.time
+        self.state.step_count as f64 * self.state.dt
     }
     /// Time step.
     pub fn dt(&self) -> f64 {
-        self.dt
+        self.state.dt
     }
     /// The world's seeded generator.
     pub fn rng(&mut self) -> &mut Rng {
-        self.rng
+        &mut self.state.rng
     }
     /// The scripts' shared state (`world().vars`).
     pub fn vars(&self) -> &Props {
-        self.vars
+        &self.state.vars
     }
     /// The scripts' shared state, to change.
     pub fn vars_mut(&mut self) -> &mut Props {
-        self.vars
+        &mut self.state.vars
     }
     /// Seconds since critter `id` was spawned (see [`crate::world::World::age`]).
     pub fn age(&self, id: CritterId) -> Option<f64> {
-        self.critters.get(id)?;
-        Some(self.births.age(id, self.step, self.dt))
+        self.state.critters.get(id)?;
+        Some(
+            self.state
+                .births
+                .age(id, self.state.step_count, self.state.dt),
+        )
     }
     /// True when critter `id` is of kind `kind` or a kind that extends it.
     pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {
-        self.critters
+        self.state
+            .critters
             .get(id)
-            .is_some_and(|c| self.kinds.is_kind(c.kind(), kind))
+            .is_some_and(|c| self.state.kinds.is_kind(c.kind(), kind))
     }
     /// Live critters of `kind` (or kinds extending it), in id order. O(N).
     pub fn critters_of(&self, kind: KindId) -> Vec<CritterId> {
-        self.critters
+        self.state
+            .critters
             .iter()
-            .filter(|c| c.in_play() && self.kinds.is_kind(c.kind(), kind))
+            .filter(|c| c.in_play() && self.state.kinds.is_kind(c.kind(), kind))
             .map(|c| c.id)
             .collect()
     }
     /// Kills critter `id`: it takes no further collisions and is removed after the step.
     pub fn die(&mut self, id: CritterId) {
-        if let Some(c) = self.critters.get_mut(id) {
+        if let Some(c) = self.state.critters.get_mut(id) {
             if c.in_play() {
                 c.alive = false;
-                self.pending.deaths.push(id);
+                self.state.pending.deaths.push(id);
             }
         }
     }
     /// Pop's `damage`: lowers health by `amount`; at or below zero the critter dies.
     pub fn damage(&mut self, id: CritterId, amount: f64) {
-        let dead = match self.critters.get_mut(id) {
+        let dead = match self.state.critters.get_mut(id) {
             Some(c) if c.in_play() => {
                 c.traits_mut().health -= amount;
-                self.events.damages.push((id, amount));
+                self.state.events.damages.push((id, amount));
                 c.health() <= 0.0
             }
             _ => false,
@@ -205,7 +196,7 @@ impl<V: Vector> Access<'_, V> {
         on_overlap: OnOverlap,
         origin: Option<Box<SpawnOrigin>>,
     ) {
-        self.pending.spawns.push(PendingSpawn {
+        self.state.pending.spawns.push(PendingSpawn {
             spec,
             on_overlap,
             origin,
@@ -213,28 +204,31 @@ impl<V: Vector> Access<'_, V> {
     }
     /// Adds a line to the step's log.
     pub fn log(&mut self, line: impl Into<String>) {
-        self.events.log.push(line.into());
+        self.state.events.log.push(line.into());
     }
     /// `b - a`, through the border when it wraps.
     pub fn delta(&self, a: V, b: V) -> V {
-        self.topo.delta(a, b)
+        self.state.topo.delta(a, b)
     }
     /// Distance between the centres of `a` and `b` (through the border when it wraps).
     pub fn distance_pair(&self, a: CritterId, b: CritterId) -> Option<f64> {
-        let (a, b) = (self.critters.get(a)?, self.critters.get(b)?);
-        Some(self.topo.delta(a.pos, b.pos).length())
+        let (a, b) = (self.state.critters.get(a)?, self.state.critters.get(b)?);
+        Some(self.state.topo.delta(a.pos, b.pos).length())
     }
     /// True when `a` and `b` touch now.
     pub fn touches_pair(&self, a: CritterId, b: CritterId) -> bool {
-        match (self.critters.get(a), self.critters.get(b)) {
-            (Some(a), Some(b)) => default_response::touches(self.topo, a, b),
+        match (self.state.critters.get(a), self.state.critters.get(b)) {
+            (Some(a), Some(b)) => default_response::touches(&self.state.topo, a, b),
             _ => false,
         }
     }
     /// Pop's `contains`: `inner` lies wholly inside `outer` (disks only).
     pub fn contains_pair(&self, outer: CritterId, inner: CritterId) -> bool {
-        match (self.critters.get(outer), self.critters.get(inner)) {
-            (Some(o), Some(i)) => default_response::contains(self.topo, o, i),
+        match (
+            self.state.critters.get(outer),
+            self.state.critters.get(inner),
+        ) {
+            (Some(o), Some(i)) => default_response::contains(&self.state.topo, o, i),
             _ => false,
         }
     }
@@ -244,13 +238,16 @@ impl<V: Vector> Access<'_, V> {
         if caller == arg {
             return None;
         }
-        let (a, b) = (self.critters.slot_of(caller)?, self.critters.slot_of(arg)?);
-        let topo = self.topo;
-        self.neighbours.moved(caller);
-        self.neighbours.moved(arg);
-        let (me, other) = self.critters.pair_mut_moving(a, b);
-        let hit = default_response::collide_default(topo, me, other)?;
-        self.events.collisions.push(CollisionEvent {
+        let (a, b) = (
+            self.state.critters.slot_of(caller)?,
+            self.state.critters.slot_of(arg)?,
+        );
+        let state = &mut *self.state;
+        state.neighbours.moved(caller);
+        state.neighbours.moved(arg);
+        let (me, other) = state.critters.pair_mut_moving(a, b);
+        let hit = default_response::collide_default(&state.topo, me, other)?;
+        state.events.collisions.push(CollisionEvent {
             caller,
             arg,
             point: hit.point,
@@ -287,6 +284,7 @@ impl<V: Vector> CollideCtx<'_, V> {
     /// The caller.
     pub fn me(&self) -> &Critter<V> {
         self.access
+            .state
             .critters
             .slot(self.me)
             .expect("caller is live during its collide")
@@ -294,18 +292,19 @@ impl<V: Vector> CollideCtx<'_, V> {
     /// The arg.
     pub fn other(&self) -> &Critter<V> {
         self.access
+            .state
             .critters
             .slot(self.other)
             .expect("arg is live during the collide")
     }
     /// Both, mutably: (me, other).
     pub fn both_mut(&mut self) -> (&mut Critter<V>, &mut Critter<V>) {
-        if self.access.neighbours.is_tracking() {
+        if self.access.state.neighbours.is_tracking() {
             let (me, other) = (self.me().id, self.other().id);
-            self.access.neighbours.moved(me);
-            self.access.neighbours.moved(other);
+            self.access.state.neighbours.moved(me);
+            self.access.state.neighbours.moved(other);
         }
-        self.access.critters.pair_mut(self.me, self.other)
+        self.access.state.critters.pair_mut(self.me, self.other)
     }
     /// The caller, mutably.
     pub fn me_mut(&mut self) -> &mut Critter<V> {
@@ -317,11 +316,13 @@ impl<V: Vector> CollideCtx<'_, V> {
     }
     /// Distance between the centres (through the border when it wraps).
     pub fn distance(&self) -> f64 {
-        self.topo.delta(self.me().pos, self.other().pos).length()
+        self.topology()
+            .delta(self.me().pos, self.other().pos)
+            .length()
     }
     /// The contact of me with the other, where they are now.
     pub fn contact(&self) -> HookContact<V> {
-        HookContact::between(self.topo, self.me(), self.other(), self.first)
+        HookContact::between(self.topology(), self.me(), self.other(), self.first)
     }
     /// True when the two touch now.
     pub fn touches(&self) -> bool {
@@ -375,17 +376,19 @@ impl<V: Vector> UpdateCtx<'_, V> {
     /// The critter being updated.
     pub fn me(&self) -> &Critter<V> {
         self.access
+            .state
             .critters
             .slot(self.me)
             .expect("updated critter is live")
     }
     /// The critter being updated, mutably.
     pub fn me_mut(&mut self) -> &mut Critter<V> {
-        if self.access.neighbours.is_tracking() {
+        if self.access.state.neighbours.is_tracking() {
             let id = self.me().id;
-            self.access.neighbours.moved(id);
+            self.access.state.neighbours.moved(id);
         }
         self.access
+            .state
             .critters
             .slot_mut(self.me)
             .expect("updated critter is live")

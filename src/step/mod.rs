@@ -2,12 +2,14 @@
 //! [`crate::world`] (which builds and owns a world) and [`crate::method`] (which plans a step
 //! and runs these stages in its own order).
 //!
-//! - [`state`]: what every stage and method reads and writes;
+//! - [`state`]: what every stage and method reads and writes; [`span`]: the step's length,
+//!   made once per step and passed down;
 //! - the stages, each in a file named after it: `update`, `motion`, `pairs`, `response`,
 //!   `touch`, `lifecycle`;
 //! - what the stages keep or queue: the neighbour grid (`neighbours`), the touching spells
-//!   (`touch`), spawn steps (`births`), the step's events and the hooks' queued changes
-//!   (`context`);
+//!   (`spells`), spawn steps (`births`), the step's events (`events`), the hooks' queued
+//!   changes (`pending`) and how spawns are placed (`spawn`);
+//! - [`access`]: what hooks and script functions may read and change;
 //! - [`stats`]: the stages' timers and counts.
 
 pub(crate) mod access;

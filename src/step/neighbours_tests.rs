@@ -158,11 +158,12 @@ impl KindHooks<DVec2> for Mover {
         for (r, kind) in [(1.0, None), (4.0, None), (4.0, Some(ctx.me().kind()))] {
             let got = ctx.nearby(centre, r, kind, Some(me));
             let want: Vec<CritterId> = ctx
+                .state
                 .critters
                 .iter()
                 .filter(|c| c.alive && !c.is_wall() && c.id != me)
                 .filter(|c| kind.is_none_or(|k| c.kind() == k))
-                .filter(|c| ctx.topo.delta(centre, c.pos).length() <= r)
+                .filter(|c| ctx.state.topo.delta(centre, c.pos).length() <= r)
                 .map(|c| c.id)
                 .collect();
             self.asked.set(self.asked.get() + 1);

@@ -50,20 +50,7 @@ pub(crate) struct State<V: Vector> {
 impl<V: Vector> State<V> {
     /// What a hook may read and write.
     pub(crate) fn access(&mut self) -> Access<'_, V> {
-        Access {
-            critters: &mut self.critters,
-            kinds: &self.kinds,
-            topo: &self.topo,
-            pending: &mut self.pending,
-            events: &mut self.events,
-            vars: &mut self.vars,
-            births: &self.births,
-            rng: &mut self.rng,
-            neighbours: &mut self.neighbours,
-            step: self.step_count,
-            time: self.step_count as f64 * self.dt,
-            dt: self.dt,
-        }
+        Access { state: self }
     }
 
     /// Runs critter `id`'s `init` hook.

@@ -5,9 +5,9 @@ use super::run::TestRun;
 use super::world::{step_count, step_scene, with_scene};
 use crate::scenes::AnyWorld;
 use crate::script::api::checks::describe;
+use crate::script::api::Api;
 use crate::script::api::{fail, CritterRef, Res};
-use crate::script::host::Host;
-use rhai::{Engine, INT};
+use rhai::INT;
 use std::rc::Rc;
 
 /// True when `a` and `b` collided in the last step, either calling.
@@ -27,9 +27,9 @@ fn collided(world: &AnyWorld, a: CritterRef, b: CritterRef) -> bool {
     }
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>, run: &Rc<TestRun>) {
-    let (h, test) = (host.clone(), run.clone());
-    engine.register_fn("expect_collision", move |a: CritterRef, b: CritterRef, within: INT| -> Res<INT> {
+pub(super) fn register(api: &mut Api, run: &Rc<TestRun>) {
+    let test = run.clone();
+    api.func("expect_collision", |h| move |a: CritterRef, b: CritterRef, within: INT| -> Res<INT> {
         let start = step_count(&h);
         let (da, db) = (describe(&h, a), describe(&h, b));
         for taken in 1..=within.max(0) {

@@ -7,9 +7,10 @@ use super::world::{flat, with_scene};
 use crate::recording::keyframes::default_record_every;
 use crate::recording::{EndMeta, Recorder, Recording, RunMeta, RunOverrides, SceneSource};
 use crate::scenes::{AnyWorld, Scene, SourceFile};
+use crate::script::api::Api;
 use crate::script::api::{error, fail, Res};
 use crate::script::host::Host;
-use rhai::{Engine, EvalAltResult};
+use rhai::EvalAltResult;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -198,9 +199,9 @@ fn bless(host: &Host, run: &TestRun, file: &Path, path: &str) -> Res<()> {
     Ok(())
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>, run: &Rc<TestRun>) {
-    let (h, test) = (host.clone(), run.clone());
-    engine.register_fn("expect_matches_recording", move |path: &str| -> Res<()> {
-        expect_matches_recording(&h, &test, path)
+pub(super) fn register(api: &mut Api, run: &Rc<TestRun>) {
+    let test = run.clone();
+    api.func("expect_matches_recording", |h| {
+        move |path: &str| -> Res<()> { expect_matches_recording(&h, &test, path) }
     });
 }

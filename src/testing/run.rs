@@ -4,11 +4,12 @@
 use super::{record, TestCase, TestOptions, TestOutcome};
 use crate::error::{Error, ScriptError};
 use crate::recording::Recorder;
+use crate::script::api::Api;
 use crate::script::api::Res;
 use crate::script::errors::{eval_error, fn_location};
 use crate::script::host::Host;
 use crate::script::{read_script, Extension, Limits, Runtime};
-use rhai::{Dynamic, Engine, Scope};
+use rhai::{Dynamic, Scope};
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -42,9 +43,9 @@ impl TestRun {
 }
 
 impl Extension for TestRun {
-    fn register(self: Rc<Self>, engine: &mut Engine, host: &Rc<Host>) {
+    fn register(self: Rc<Self>, api: &mut Api) {
         let run = self.clone();
-        engine.on_progress(move |ops| {
+        api.engine.on_progress(move |ops| {
             if ops % 4096 == 0 && Instant::now() > run.deadline {
                 return Some(Dynamic::from(
                     "the test ran out of time (--timeout)".to_string(),
@@ -52,9 +53,9 @@ impl Extension for TestRun {
             }
             None
         });
-        super::world::register(engine, host, &self);
-        super::asserts::register(engine, host, &self);
-        record::register(engine, host, &self);
+        super::world::register(api, &self);
+        super::asserts::register(api, &self);
+        record::register(api, &self);
     }
 
     fn scene_made(&self, host: &Host) -> Res<()> {

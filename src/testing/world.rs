@@ -6,11 +6,12 @@ use super::record;
 use super::run::TestRun;
 use crate::error::Error;
 use crate::scenes::Scene;
+use crate::script::api::Api;
 use crate::script::api::{error, fail, Res, WorldRef};
 use crate::script::host::{Host, NoScene};
 use crate::script::ScriptOptions;
 use glam::DVec3;
-use rhai::{Dynamic, Engine, FnPtr, Map, NativeCallContext, INT};
+use rhai::{Dynamic, FnPtr, Map, NativeCallContext, INT};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -89,27 +90,23 @@ fn load_scene(host: &Rc<Host>, path: &str, sets: &Map) -> Res<WorldRef> {
     Ok(WorldRef)
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>, run: &Rc<TestRun>) {
-    let h = host.clone();
-    engine.register_fn("load_scene", move |path: &str| -> Res<WorldRef> {
-        load_scene(&h, path, &Map::new())
+pub(super) fn register(api: &mut Api, run: &Rc<TestRun>) {
+    api.func("load_scene", |h| {
+        move |path: &str| -> Res<WorldRef> { load_scene(&h, path, &Map::new()) }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "load_scene",
-        move |path: &str, sets: Map| -> Res<WorldRef> { load_scene(&h, path, &sets) },
-    );
-    let (h, test) = (host.clone(), run.clone());
-    engine.register_fn("step", move |_: &mut WorldRef| -> Res<()> {
-        step_scene(&h, &test, 1)
+    api.func("load_scene", |h| {
+        move |path: &str, sets: Map| -> Res<WorldRef> { load_scene(&h, path, &sets) }
     });
-    let (h, test) = (host.clone(), run.clone());
-    engine.register_fn("step", move |_: &mut WorldRef, n: INT| -> Res<()> {
-        step_scene(&h, &test, n)
+    let test = run.clone();
+    api.func("step", |h| {
+        move |_: &mut WorldRef| -> Res<()> { step_scene(&h, &test, 1) }
     });
-    let (h, test) = (host.clone(), run.clone());
-    engine.register_fn(
-        "run_until",
+    let test = run.clone();
+    api.func("step", |h| {
+        move |_: &mut WorldRef, n: INT| -> Res<()> { step_scene(&h, &test, n) }
+    });
+    let test = run.clone();
+    api.func("run_until", |h| {
         move |ctx: NativeCallContext, w: &mut WorldRef, cond: FnPtr, max_steps: INT| -> Res<INT> {
             for taken in 0..=max_steps.max(0) {
                 let met = cond.call_within_context::<Dynamic>(&ctx, (*w,))?;
@@ -130,14 +127,14 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>, run: &Rc<TestRun>) 
                 "run_until: the condition did not hold within {max_steps} steps (now at step {})",
                 step_count(&h)
             ))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("kinetic_energy", move |_: &mut WorldRef| -> Res<f64> {
-        with_scene(&h, |s| s.world.kinetic_energy())
+        }
     });
-    let h = host.clone();
-    engine.register_fn("momentum", move |_: &mut WorldRef| -> Res<DVec3> {
-        with_scene(&h, |s| DVec3::from_array(s.world.momentum()))
+    api.func("kinetic_energy", |h| {
+        move |_: &mut WorldRef| -> Res<f64> { with_scene(&h, |s| s.world.kinetic_energy()) }
+    });
+    api.func("momentum", |h| {
+        move |_: &mut WorldRef| -> Res<DVec3> {
+            with_scene(&h, |s| DVec3::from_array(s.world.momentum()))
+        }
     });
 }

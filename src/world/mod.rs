@@ -1,7 +1,7 @@
 //! The world: critters in a box, the kinds that give their rules, and the step.
 //!
 //! [`World::step`] (in `step.rs`) is a recipe of named stages, each in a file of its own under
-//! `stages/` and each timed ([`StepStats`]):
+//! `src/step/` and each timed ([`StepStats`]):
 //!
 //! 1. **update**: each critter whose kind has an `update` hook runs it;
 //! 2. the collision method's part (see [`crate::method`]): under Pop's step, `n` times
@@ -10,7 +10,8 @@
 //!    put in a fixed order) and **response** (the caller's `collide` for each touching pair
 //!    whose two critters are both still alive, or the contacts solved together); under the
 //!    event methods, a flight from event to event;
-//! 3. **lifecycle**: the dead are removed, queued spawns are added.
+//! 3. **touch**: the touching spells' begins and ends, when some kind has touch hooks;
+//! 4. **lifecycle**: the dead are removed, queued spawns are added.
 //!
 //! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
@@ -233,6 +234,10 @@ impl<V: Vector> World<V> {
     /// Stage times and counts summed over all steps.
     pub fn totals(&self) -> &StepStats {
         &self.totals
+    }
+    /// The world between steps as a hook sees it inside one (scene scripts reach it so).
+    pub(crate) fn access(&mut self) -> crate::step::access::Access<'_, V> {
+        self.state.access()
     }
     /// How the engine's caches and layouts have behaved (for `--stats` and tests).
     pub fn diagnostics(&self) -> Diagnostics<'_> {

@@ -308,7 +308,7 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// `world/stages/pairs.rs` -> [world, stages, pairs]; `method/mod.rs` -> [method].
+/// `step/pairs/tests.rs` -> [step, pairs, tests]; `method/mod.rs` -> [method].
 fn module_of(file: &str) -> Vec<String> {
     let mut parts: Vec<String> = file
         .trim_end_matches(".rs")

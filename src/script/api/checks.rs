@@ -3,12 +3,12 @@
 //! step.
 
 use super::critter::CritterRef;
+use super::registry::Api;
 use super::values::num;
 use super::{fail, Res};
 use crate::script::host::{with_env, Host};
 use glam::DVec3;
-use rhai::{Dynamic, Engine, NativeCallContext};
-use std::rc::Rc;
+use rhai::{Dynamic, NativeCallContext};
 
 /// `critter 3 (bullet)`, or `critter 3 (gone)`.
 pub(crate) fn describe(host: &Host, c: CritterRef) -> String {
@@ -91,49 +91,48 @@ fn step_now(host: &Host) -> u64 {
     step.unwrap_or(0)
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    engine.register_fn("assert", |cond: bool| -> Res<()> {
+pub(super) fn register(api: &mut Api) {
+    api.engine.register_fn("assert", |cond: bool| -> Res<()> {
         if cond {
             Ok(())
         } else {
             fail("assertion failed")
         }
     });
-    engine.register_fn("assert", |cond: bool, msg: Dynamic| -> Res<()> {
-        if cond {
-            Ok(())
-        } else {
-            fail(format!("assertion failed: {msg}"))
-        }
-    });
-    engine.register_fn(
+    api.engine
+        .register_fn("assert", |cond: bool, msg: Dynamic| -> Res<()> {
+            if cond {
+                Ok(())
+            } else {
+                fail(format!("assertion failed: {msg}"))
+            }
+        });
+    api.engine.register_fn(
         "assert_eq",
         |ctx: NativeCallContext, a: Dynamic, b: Dynamic| -> Res<()> {
             assert_eq(&ctx, &a, &b, None)
         },
     );
-    engine.register_fn(
+    api.engine.register_fn(
         "assert_eq",
         |ctx: NativeCallContext, a: Dynamic, b: Dynamic, msg: Dynamic| -> Res<()> {
             assert_eq(&ctx, &a, &b, Some(&msg))
         },
     );
-    engine.register_fn(
+    api.engine.register_fn(
         "assert_near",
         |a: Dynamic, b: Dynamic, tol: Dynamic| -> Res<()> { assert_near(&a, &b, &tol, None) },
     );
-    engine.register_fn(
+    api.engine.register_fn(
         "assert_near",
         |a: Dynamic, b: Dynamic, tol: Dynamic, msg: Dynamic| -> Res<()> {
             assert_near(&a, &b, &tol, Some(&msg))
         },
     );
-    let h = host.clone();
-    engine.register_fn("expect_dead", move |c: CritterRef| -> Res<()> {
-        expect_state(&h, c, false)
+    api.func("expect_dead", |h| {
+        move |c: CritterRef| -> Res<()> { expect_state(&h, c, false) }
     });
-    let h = host.clone();
-    engine.register_fn("expect_alive", move |c: CritterRef| -> Res<()> {
-        expect_state(&h, c, true)
+    api.func("expect_alive", |h| {
+        move |c: CritterRef| -> Res<()> { expect_state(&h, c, true) }
     });
 }

@@ -2,6 +2,7 @@
 //! user properties (`c["score"]`, `c.score`) goes to the world; it also answers questions about
 //! pairs (`touches`, `contains`, `distance`) and acts (`damage`, `die`, `collide_default`).
 
+use super::registry::Api;
 use super::values::{from_prop, from_svec, num_or, to_prop, to_svec};
 use super::{error, fail, fail_hint, lib_err, Res};
 use crate::critter::{CritterId, PropValue};
@@ -9,8 +10,7 @@ use crate::script::host::{with_env, Host};
 use crate::step::spawn::check_radius_in_box;
 use crate::vector::Vector;
 use glam::DVec3;
-use rhai::{Dynamic, Engine, EvalAltResult, INT};
-use std::rc::Rc;
+use rhai::{Dynamic, EvalAltResult, INT};
 
 /// A handle to a critter, as scripts see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,9 +24,8 @@ pub(super) fn gone(id: CritterId) -> Box<EvalAltResult> {
 }
 
 macro_rules! critter_field {
-    ($engine:expr, $host:expr, $name:literal, |$c:ident| $get:expr) => {{
-        let h = $host.clone();
-        $engine.register_get($name, move |r: &mut CritterRef| -> Res<_> {
+    ($api:expr, $name:literal, |$c:ident| $get:expr) => {{
+        $api.get($name, |h| move |r: &mut CritterRef| -> Res<_> {
             let id = r.0;
             with_env!(h, env => match env.critter(id) {
                 Some($c) => Ok($get),
@@ -37,9 +36,8 @@ macro_rules! critter_field {
 }
 
 macro_rules! critter_setter {
-    ($engine:expr, $host:expr, $name:literal, $ty:ty, |$c:ident, $v:ident| $set:expr) => {{
-        let h = $host.clone();
-        $engine.register_set($name, move |r: &mut CritterRef, $v: $ty| -> Res<()> {
+    ($api:expr, $name:literal, $ty:ty, |$c:ident, $v:ident| $set:expr) => {{
+        $api.set($name, |h| move |r: &mut CritterRef, $v: $ty| -> Res<()> {
             let id = r.0;
             with_env!(h, env => match env.critter_mut(id) {
                 Some($c) => $set,
@@ -133,84 +131,85 @@ fn set_num(
     Ok(())
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    engine.register_type_with_name::<CritterRef>("Critter");
-    engine.register_fn("==", |a: CritterRef, b: CritterRef| a == b);
-    engine.register_fn("!=", |a: CritterRef, b: CritterRef| a != b);
+pub(super) fn register(api: &mut Api) {
+    api.engine.register_type_with_name::<CritterRef>("Critter");
+    api.engine
+        .register_fn("==", |a: CritterRef, b: CritterRef| a == b);
+    api.engine
+        .register_fn("!=", |a: CritterRef, b: CritterRef| a != b);
     let show = |c: &mut CritterRef| format!("critter {}", c.0);
-    engine.register_fn("to_string", show);
-    engine.register_fn("to_debug", show);
+    api.engine.register_fn("to_string", show);
+    api.engine.register_fn("to_debug", show);
 
-    critter_field!(engine, host, "pos", |c| to_svec(c.pos));
-    critter_field!(engine, host, "vel", |c| to_svec(c.vel));
-    critter_field!(engine, host, "radius", |c| c.radius());
-    critter_field!(engine, host, "mass", |c| c.mass());
-    critter_field!(engine, host, "health", |c| c.health());
-    critter_field!(engine, host, "restitution", |c| c.restitution());
-    critter_field!(engine, host, "priority", |c| c.priority());
-    critter_field!(engine, host, "fixed", |c| c.is_fixed());
-    critter_field!(engine, host, "is_wall", |c| c.is_wall());
+    critter_field!(api, "pos", |c| to_svec(c.pos));
+    critter_field!(api, "vel", |c| to_svec(c.vel));
+    critter_field!(api, "radius", |c| c.radius());
+    critter_field!(api, "mass", |c| c.mass());
+    critter_field!(api, "health", |c| c.health());
+    critter_field!(api, "restitution", |c| c.restitution());
+    critter_field!(api, "priority", |c| c.priority());
+    critter_field!(api, "fixed", |c| c.is_fixed());
+    critter_field!(api, "is_wall", |c| c.is_wall());
     {
         // A dead critter's handle answers `alive` with false rather than an error.
-        let h = host.clone();
-        engine.register_get("alive", move |r: &mut CritterRef| -> Res<bool> {
-            let id = r.0;
-            with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.is_alive())))
+        api.get("alive", |h| {
+            move |r: &mut CritterRef| -> Res<bool> {
+                let id = r.0;
+                with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.is_alive())))
+            }
         });
     }
-    critter_field!(engine, host, "id", |c| c.id().index as INT);
+    critter_field!(api, "id", |c| c.id().index as INT);
     {
-        let h = host.clone();
-        engine.register_get("kind", move |r: &mut CritterRef| -> Res<String> {
-            let id = r.0;
-            with_env!(h, env => match env.critter(id) {
-                Some(c) => Ok(env.kinds().name(c.kind()).to_string()),
-                None => Err(gone(id)),
-            })
+        api.get("kind", |h| {
+            move |r: &mut CritterRef| -> Res<String> {
+                let id = r.0;
+                with_env!(h, env => match env.critter(id) {
+                    Some(c) => Ok(env.kinds().name(c.kind()).to_string()),
+                    None => Err(gone(id)),
+                })
+            }
         });
     }
-    critter_setter!(engine, host, "pos", DVec3, |c, v| set_vec(
-        &mut c.pos, v, "pos"
-    ));
-    critter_setter!(engine, host, "vel", DVec3, |c, v| set_vec(
-        &mut c.vel, v, "vel"
-    ));
+    critter_setter!(api, "pos", DVec3, |c, v| set_vec(&mut c.pos, v, "pos"));
+    critter_setter!(api, "vel", DVec3, |c, v| set_vec(&mut c.vel, v, "vel"));
     // A new radius must fit in the world box, as a spawn's must.
-    let h = host.clone();
-    engine.register_set("radius", move |r: &mut CritterRef, v: Dynamic| -> Res<()> {
-        let (id, radius) = (r.0, num_or(&v, "radius")?);
-        with_env!(h, env => {
-            if let Some(c) = env.critter(id) {
-                check_radius_in_box(env.topology(), || c.describe(), radius).map_err(lib_err)?;
-            }
-            match env.critter_mut(id) {
-                Some(c) => c.set_radius(radius).map_err(lib_err),
-                None => if env.critter(id).is_some() {
-                    fail("critters are read-only in collides_with: radius cannot be set there")
-                } else {
-                    Err(gone(id))
-                },
-            }
-        })
+    api.set("radius", |h| {
+        move |r: &mut CritterRef, v: Dynamic| -> Res<()> {
+            let (id, radius) = (r.0, num_or(&v, "radius")?);
+            with_env!(h, env => {
+                if let Some(c) = env.critter(id) {
+                    check_radius_in_box(env.topology(), || c.describe(), radius).map_err(lib_err)?;
+                }
+                match env.critter_mut(id) {
+                    Some(c) => c.set_radius(radius).map_err(lib_err),
+                    None => if env.critter(id).is_some() {
+                        fail("critters are read-only in collides_with: radius cannot be set there")
+                    } else {
+                        Err(gone(id))
+                    },
+                }
+            })
+        }
     });
-    critter_setter!(engine, host, "mass", Dynamic, |c, v| c
+    critter_setter!(api, "mass", Dynamic, |c, v| c
         .set_mass(num_or(&v, "mass")?)
         .map_err(lib_err));
-    critter_setter!(engine, host, "priority", Dynamic, |c, v| c
+    critter_setter!(api, "priority", Dynamic, |c, v| c
         .set_priority(num_or(&v, "priority")?)
         .map_err(lib_err));
-    critter_setter!(engine, host, "fixed", bool, |c, v| {
+    critter_setter!(api, "fixed", bool, |c, v| {
         c.set_fixed(v);
         Ok(())
     });
-    critter_setter!(engine, host, "health", Dynamic, |c, v| set_num(
+    critter_setter!(api, "health", Dynamic, |c, v| set_num(
         &mut c.traits_mut().health,
         &v,
         "health",
         f64::is_finite,
         "must be a finite number"
     ));
-    critter_setter!(engine, host, "restitution", Dynamic, |c, v| set_num(
+    critter_setter!(api, "restitution", Dynamic, |c, v| set_num(
         &mut c.traits_mut().restitution,
         &v,
         "restitution",
@@ -220,8 +219,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
 
     // The colour it is drawn in: its own (`me.color = "red"` or "#rrggbb"), else its kind's.
     {
-        let h = host.clone();
-        engine.register_get("color", move |r: &mut CritterRef| -> Res<String> {
+        api.get("color", |h| move |r: &mut CritterRef| -> Res<String> {
             let id = r.0;
             with_env!(h, env => match env.critter(id) {
                 Some(c) => Ok(match c.color() {
@@ -242,7 +240,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
             })
         });
     }
-    critter_setter!(engine, host, "color", Dynamic, |c, v| {
+    critter_setter!(api, "color", Dynamic, |c, v| {
         match v
         .clone()
         .try_cast::<rhai::ImmutableString>()
@@ -257,8 +255,7 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     });
 
     // User properties: c["name"], and c.name when no field of that name exists.
-    let h = host.clone();
-    engine.register_indexer_get(move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {
+    api.index_get(|h| move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {
         let id = r.0;
         with_env!(h, env => match env.critter(id) {
             Some(c) => match c.props().get(name) {
@@ -273,47 +270,42 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     });
     // Setting an existing property, or one the kind or spawn map declared. A new name is an
     // error, so a typo (`me.velocity = ...`) is caught; `set_prop` adds one on purpose.
-    let h = host.clone();
-    engine.register_indexer_set(
+    api.index_set(|h| {
         move |r: &mut CritterRef, name: &str, value: Dynamic| -> Res<()> {
             set_prop(&h, r.0, name, &value, false)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "set_prop",
+        }
+    });
+    api.func("set_prop", |h| {
         move |r: &mut CritterRef, name: &str, value: Dynamic| -> Res<()> {
             set_prop(&h, r.0, name, &value, true)
-        },
-    );
-    // rhai gives every value a `tag`; for critters, `tag` is a user property like any other.
-    let h = host.clone();
-    engine.register_get("tag", move |r: &mut CritterRef| -> Res<Dynamic> {
-        let id = r.0;
-        with_env!(h, env => match env.critter(id) {
-            Some(c) => c.props().get("tag").map_or_else(
-                || fail(format!("critter {id} has no property 'tag'")),
-                |p| Ok(from_prop(p)),
-            ),
-            None => Err(gone(id)),
-        })
+        }
     });
-    let h = host.clone();
-    engine.register_set(
-        "tag",
+    // rhai gives every value a `tag`; for critters, `tag` is a user property like any other.
+    api.get("tag", |h| {
+        move |r: &mut CritterRef| -> Res<Dynamic> {
+            let id = r.0;
+            with_env!(h, env => match env.critter(id) {
+                Some(c) => c.props().get("tag").map_or_else(
+                    || fail(format!("critter {id} has no property 'tag'")),
+                    |p| Ok(from_prop(p)),
+                ),
+                None => Err(gone(id)),
+            })
+        }
+    });
+    api.set("tag", |h| {
         move |r: &mut CritterRef, value: Dynamic| -> Res<()> {
             set_prop(&h, r.0, "tag", &value, false)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("has", move |r: &mut CritterRef, name: &str| -> Res<bool> {
-        let id = r.0;
-        with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.props().contains_key(name))))
+        }
+    });
+    api.func("has", |h| {
+        move |r: &mut CritterRef, name: &str| -> Res<bool> {
+            let id = r.0;
+            with_env!(h, env => Ok(env.critter(id).is_some_and(|c| c.props().contains_key(name))))
+        }
     });
 
-    let h = host.clone();
-    engine.register_fn(
-        "is_kind",
+    api.kind_func("is_kind", |h| {
         move |r: &mut CritterRef, kind: &str| -> Res<bool> {
             let id = r.0;
             let known = with_env!(h, env => {
@@ -337,32 +329,25 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                     None => Err(gone(id)),
                 }
             })
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "touches",
+        }
+    });
+    api.func("touches", |h| {
         move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
             let a = a.0;
             with_env!(h, env => Ok(env.touches(a, b.0)))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "contains",
+        }
+    });
+    api.func("contains", |h| {
         move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
             let a = a.0;
             with_env!(h, env => Ok(env.contains(a, b.0)))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("distance", move |a: &mut CritterRef, b: CritterRef| -> Res<f64> {
+        }
+    });
+    api.func("distance", |h| move |a: &mut CritterRef, b: CritterRef| -> Res<f64> {
         let a = a.0;
         with_env!(h, env => env.distance(a, b.0).map_or_else(|| Err(gone(if env.critter(a).is_none() { a } else { b.0 })), Ok))
     });
-    let h = host.clone();
-    engine.register_fn(
-        "damage",
+    api.func("damage", |h| {
         move |a: &mut CritterRef, amount: Dynamic| -> Res<()> {
             let a = a.0;
             let amount = num_or(&amount, "damage")?;
@@ -370,25 +355,24 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 env.damage(a, amount);
                 Ok(())
             })
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("die", move |a: &mut CritterRef| -> Res<()> {
-        let a = a.0;
-        with_env!(h, env => {
-            env.die(a);
-            Ok(())
-        })
+        }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "collide_default",
+    api.func("die", |h| {
+        move |a: &mut CritterRef| -> Res<()> {
+            let a = a.0;
+            with_env!(h, env => {
+                env.die(a);
+                Ok(())
+            })
+        }
+    });
+    api.func("collide_default", |h| {
         move |a: &mut CritterRef, b: CritterRef| -> Res<bool> {
             let a = a.0;
             let hit = with_env!(h, env => env.collide_default(a, b.0).or_else(fail))?;
             // A collide hook's contact reads the impulse of its last default response.
             crate::script::kind_file::note_default(&h, a, b.0, hit);
             Ok(hit.is_some())
-        },
-    );
+        }
+    });
 }

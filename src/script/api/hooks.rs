@@ -1,17 +1,18 @@
 //! What the second round of hooks sees: `Contact` (`collide`'s third argument and
 //! `touch_begin`'s), the `parent_*` calls that reach a parent kind's hook, and `me.age`.
 
+use super::registry::Api;
 use super::values::to_svec;
 use super::{fail, num_or, Res};
 use crate::critter::CritterId;
 use crate::script::api::CritterRef;
 use crate::script::env::Env;
-use crate::script::host::{with_env, Host};
+use crate::script::host::with_env;
 use crate::script::kind_file::{parent_collide, parent_collides_with, parent_plain};
 use crate::step::access::HookContact;
 use crate::vector::Vector;
 use glam::DVec3;
-use rhai::{Dynamic, Engine};
+use rhai::Dynamic;
 use std::cell::Cell;
 use std::rc::Rc;
 
@@ -49,7 +50,7 @@ impl ScriptContact {
 
     /// The contact of `me` with `other` where they are now.
     pub(crate) fn between<V: Vector>(
-        env: &dyn Env<V>,
+        env: &Env<'_, V>,
         me: CritterId,
         other: CritterId,
         first: bool,
@@ -66,14 +67,20 @@ impl ScriptContact {
     }
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    engine.register_type_with_name::<ScriptContact>("Contact");
-    engine.register_get("normal", |c: &mut ScriptContact| c.normal);
-    engine.register_get("point", |c: &mut ScriptContact| c.point);
-    engine.register_get("depth", |c: &mut ScriptContact| c.depth);
-    engine.register_get("speed", |c: &mut ScriptContact| c.speed);
-    engine.register_get("first", |c: &mut ScriptContact| c.first);
-    engine.register_get("impulse", |c: &mut ScriptContact| {
+pub(super) fn register(api: &mut Api) {
+    api.engine
+        .register_type_with_name::<ScriptContact>("Contact");
+    api.engine
+        .register_get("normal", |c: &mut ScriptContact| c.normal);
+    api.engine
+        .register_get("point", |c: &mut ScriptContact| c.point);
+    api.engine
+        .register_get("depth", |c: &mut ScriptContact| c.depth);
+    api.engine
+        .register_get("speed", |c: &mut ScriptContact| c.speed);
+    api.engine
+        .register_get("first", |c: &mut ScriptContact| c.first);
+    api.engine.register_get("impulse", |c: &mut ScriptContact| {
         c.impulse.as_ref().map_or(0.0, |cell| cell.get())
     });
     let show = |c: &mut ScriptContact| {
@@ -82,50 +89,42 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
             c.normal, c.depth, c.speed, c.first
         )
     };
-    engine.register_fn("to_string", show);
-    engine.register_fn("to_debug", show);
+    api.engine.register_fn("to_string", show);
+    api.engine.register_fn("to_debug", show);
 
-    let h = host.clone();
-    engine.register_fn(
-        "parent_collide",
+    api.func("parent_collide", |h| {
         move |me: &mut CritterRef, other: CritterRef| -> Res<bool> {
             parent_collide(&h, me.0, other.0, None)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "parent_collide",
+        }
+    });
+    api.func("parent_collide", |h| {
         move |me: &mut CritterRef, other: CritterRef, contact: ScriptContact| -> Res<bool> {
             parent_collide(&h, me.0, other.0, Some(contact))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "parent_collides_with",
+        }
+    });
+    api.func("parent_collides_with", |h| {
         move |me: &mut CritterRef, other: CritterRef| -> Res<rhai::INT> {
             parent_collides_with(&h, me.0, other.0)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "parent_update",
+        }
+    });
+    api.func("parent_update", |h| {
         move |me: &mut CritterRef, dt: Dynamic| -> Res<()> {
             let dt = num_or(&dt, "dt")?;
             parent_plain(&h, "update", me.0, Some(dt))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("parent_init", move |me: &mut CritterRef| -> Res<()> {
-        parent_plain(&h, "init", me.0, None)
+        }
+    });
+    api.func("parent_init", |h| {
+        move |me: &mut CritterRef| -> Res<()> { parent_plain(&h, "init", me.0, None) }
     });
 
-    let h = host.clone();
-    engine.register_get("age", move |me: &mut CritterRef| -> Res<f64> {
-        let id = me.0;
-        with_env!(h, env => match env.age(id) {
-            Some(age) => Ok(age),
-            None if env.critter(id).is_some() => fail("age cannot be read in collides_with"),
-            None => Err(super::critter::gone(id)),
-        })
+    api.get("age", |h| {
+        move |me: &mut CritterRef| -> Res<f64> {
+            let id = me.0;
+            with_env!(h, env => match env.age(id) {
+                Some(age) => Ok(age),
+                None if env.critter(id).is_some() => fail("age cannot be read in collides_with"),
+                None => Err(super::critter::gone(id)),
+            })
+        }
     });
 }

@@ -25,6 +25,7 @@ mod hooks;
 mod kind_decl;
 mod neighbours;
 mod random;
+mod registry;
 mod rules;
 mod scene;
 mod spawn;
@@ -37,6 +38,7 @@ mod world;
 
 pub(crate) use critter::CritterRef;
 pub(crate) use hooks::ScriptContact;
+pub(crate) use registry::Api;
 pub(crate) use rules::{rule_code, rule_of_code};
 pub(crate) use values::{num_or, props_from_map};
 pub(crate) use world::WorldRef;
@@ -82,8 +84,9 @@ pub(crate) fn lib_err(e: crate::Error) -> Box<EvalAltResult> {
 
 /// Makes the engine scripts run in: sandboxed (no files, no clock, no unseeded randomness, no
 /// `eval`), limited per call, with the whole critterbox API registered, and then the functions
-/// of the host's [`Extension`](super::Extension), if it has one.
-pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
+/// of the host's [`Extension`](super::Extension), if it has one. Also gives the functions
+/// whose string arguments name kinds (see [`Api::kind_func`]).
+pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> (Engine, Vec<&'static str>) {
     let mut engine = Engine::new();
     engine.set_module_resolver(rhai::module_resolvers::DummyModuleResolver::new());
     engine.disable_symbol("eval");
@@ -95,22 +98,24 @@ pub(crate) fn build_engine(host: &Rc<Host>, limits: &Limits) -> Engine {
     engine.set_max_map_size(limits.max_map_size);
     engine.set_fail_on_invalid_map_property(true);
     let charged = engine.set_data_walk_charge(super::DATA_WALK_ITEMS_PER_OP);
-    step_ops::install(&mut engine, host, limits.max_step_operations, charged);
 
-    rules::register(&mut engine, host);
-    vec::register(&mut engine, host);
-    critter::register(&mut engine, host);
-    hooks::register(&mut engine, host);
-    world::register(&mut engine, host);
-    vars::register(&mut engine, host);
-    neighbours::register(&mut engine, host);
-    random::register(&mut engine, host);
-    kind_decl::register(&mut engine, host);
-    scene::register(&mut engine, host);
-    checks::register(&mut engine, host);
+    let mut api = Api::new(&mut engine, host);
+    step_ops::install(&mut api, limits.max_step_operations, charged);
+    rules::register(&mut api);
+    vec::register(&mut api);
+    critter::register(&mut api);
+    hooks::register(&mut api);
+    world::register(&mut api);
+    vars::register(&mut api);
+    neighbours::register(&mut api);
+    random::register(&mut api);
+    kind_decl::register(&mut api);
+    scene::register(&mut api);
+    checks::register(&mut api);
     match host.extension.clone() {
-        Some(extension) => extension.register(&mut engine, host),
-        None => test_only::register(&mut engine),
+        Some(extension) => extension.register(&mut api),
+        None => test_only::register(&mut api),
     }
-    engine
+    let kind_calls = api.kind_calls();
+    (engine, kind_calls)
 }

@@ -4,6 +4,7 @@
 //! of the moment, in id order, looking only at the cells near the asker.
 
 use super::critter::{gone, CritterRef};
+use super::registry::Api;
 use super::spawn::kind_for_query;
 use super::values::from_svec;
 use super::world::WorldRef;
@@ -15,7 +16,7 @@ use crate::script::host::{with_env, Host};
 use crate::step::neighbours::check_radius;
 use crate::vector::Vector;
 use glam::DVec3;
-use rhai::{Array, Dynamic, Engine, INT};
+use rhai::{Array, Dynamic, INT};
 use std::rc::Rc;
 
 /// Where a query is centred: a critter (left out of the answer) or a point.
@@ -32,7 +33,7 @@ enum Ask {
     Nearest,
 }
 
-fn query<V: Vector>(env: &mut dyn Env<V>, from: From, kind: Kind, ask: Ask) -> Res<Dynamic> {
+fn query<V: Vector>(env: &mut Env<'_, V>, from: From, kind: Kind, ask: Ask) -> Res<Dynamic> {
     let call = match ask {
         Ask::Nearby(_) => "nearby",
         Ask::Nearest => "nearest",
@@ -113,32 +114,27 @@ impl Radius for INT {
 /// Registers the four `nearby` forms for radius type `R`: typed parameters let rhai find the
 /// function at its first lookup, where a `Dynamic` one makes it try every pattern of wildcards
 /// on each call.
-fn register_nearby<R: Radius>(engine: &mut Engine, host: &Rc<Host>) {
-    let h = host.clone();
-    engine.register_fn("nearby", move |me: &mut CritterRef, r: R| -> Res<Dynamic> {
-        ask(&h, From::Me(me.0), None, Ask::Nearby(r.get()))
+fn register_nearby<R: Radius>(api: &mut Api) {
+    api.kind_func("nearby", |h| {
+        move |me: &mut CritterRef, r: R| -> Res<Dynamic> {
+            ask(&h, From::Me(me.0), None, Ask::Nearby(r.get()))
+        }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "nearby",
+    api.kind_func("nearby", |h| {
         move |me: &mut CritterRef, r: R, kind: &str| -> Res<Dynamic> {
             ask(&h, From::Me(me.0), Some(kind), Ask::Nearby(r.get()))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "nearby",
+        }
+    });
+    api.kind_func("nearby", |h| {
         move |_: &mut WorldRef, pos: DVec3, r: R| -> Res<Dynamic> {
             ask(&h, From::At(pos), None, Ask::Nearby(r.get()))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "nearby",
+        }
+    });
+    api.kind_func("nearby", |h| {
         move |_: &mut WorldRef, pos: DVec3, r: R, kind: &str| -> Res<Dynamic> {
             ask(&h, From::At(pos), Some(kind), Ask::Nearby(r.get()))
-        },
-    );
+        }
+    });
 }
 
 /// The error of a `nearby` whose radius is not a number or whose kind is not a string. The
@@ -152,32 +148,31 @@ fn bad_nearby(args: &[&Dynamic]) -> Res<Dynamic> {
     ))
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    register_nearby::<f64>(engine, host);
-    register_nearby::<INT>(engine, host);
-    engine.register_fn("nearby", |_: &mut CritterRef, r: Dynamic| bad_nearby(&[&r]));
-    engine.register_fn("nearby", |_: &mut CritterRef, r: Dynamic, k: Dynamic| {
-        bad_nearby(&[&r, &k])
-    });
-    engine.register_fn("nearby", |_: &mut WorldRef, p: Dynamic, r: Dynamic| {
-        bad_nearby(&[&p, &r])
-    });
-    engine.register_fn(
+pub(super) fn register(api: &mut Api) {
+    register_nearby::<f64>(api);
+    register_nearby::<INT>(api);
+    api.engine
+        .register_fn("nearby", |_: &mut CritterRef, r: Dynamic| bad_nearby(&[&r]));
+    api.engine
+        .register_fn("nearby", |_: &mut CritterRef, r: Dynamic, k: Dynamic| {
+            bad_nearby(&[&r, &k])
+        });
+    api.engine
+        .register_fn("nearby", |_: &mut WorldRef, p: Dynamic, r: Dynamic| {
+            bad_nearby(&[&p, &r])
+        });
+    api.engine.register_fn(
         "nearby",
         |_: &mut WorldRef, p: Dynamic, r: Dynamic, k: Dynamic| bad_nearby(&[&p, &r, &k]),
     );
-    let h = host.clone();
-    engine.register_fn(
-        "nearest",
+    api.kind_func("nearest", |h| {
         move |me: &mut CritterRef, kind: &str| -> Res<Dynamic> {
             ask(&h, From::Me(me.0), Some(kind), Ask::Nearest)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "nearest",
+        }
+    });
+    api.kind_func("nearest", |h| {
         move |_: &mut WorldRef, pos: DVec3, kind: &str| -> Res<Dynamic> {
             ask(&h, From::At(pos), Some(kind), Ask::Nearest)
-        },
-    );
+        }
+    });
 }

@@ -2,12 +2,12 @@
 //! `COLLIDE_AS_CALLER`, ...) and `default_collides_with(a, b)`.
 
 use super::critter::{gone, CritterRef};
+use super::registry::Api;
 use super::Res;
 use crate::critter::PRIORITY_NAMES;
 use crate::kind::CollideRule;
-use crate::script::host::{with_env, Host};
-use rhai::{Engine, Module, INT};
-use std::rc::Rc;
+use crate::script::host::with_env;
+use rhai::{Module, INT};
 
 /// The integer scripts use for a rule.
 pub(crate) fn rule_code(rule: CollideRule) -> INT {
@@ -27,7 +27,7 @@ pub(crate) fn rule_of_code(code: INT) -> Option<CollideRule> {
         .find(|&r| rule_code(r) == code)
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+pub(super) fn register(api: &mut Api) {
     let mut module = Module::new();
     for (name, value) in PRIORITY_NAMES {
         module.set_var(name, value);
@@ -35,16 +35,14 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
     for (name, rule) in CollideRule::NAMES {
         module.set_var(name, rule_code(rule));
     }
-    engine.register_global_module(module.into());
+    api.engine.register_global_module(module.into());
 
-    let h = host.clone();
-    engine.register_fn(
-        "default_collides_with",
+    api.func("default_collides_with", |h| {
         move |a: CritterRef, b: CritterRef| -> Res<INT> {
             with_env!(h, env => match (env.critter(a.0), env.critter(b.0)) {
                 (Some(x), Some(y)) => Ok(rule_code(crate::kind::default_collides_with(x, y))),
                 _ => Err(gone(if env.critter(a.0).is_none() { a.0 } else { b.0 })),
             })
-        },
-    );
+        }
+    });
 }

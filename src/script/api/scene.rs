@@ -3,6 +3,7 @@
 //! `spawn(kind, #{ ... })` and `stop(reason)`.
 
 use super::critter::CritterRef;
+use super::registry::Api;
 use super::spawn::{spawn_in, spec_from_map};
 use super::values::{from_svec, num, num_or, to_svec};
 use super::world::WorldRef;
@@ -16,7 +17,7 @@ use crate::vector::Vector;
 use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
 use crate::world::{World, WorldConfig};
 use glam::{DMat3, DVec2, DVec3};
-use rhai::{Array, Dynamic, Engine, Map, INT};
+use rhai::{Array, Dynamic, Map, INT};
 use std::rc::Rc;
 
 /// The keys `world(#{ ... })` accepts.
@@ -167,7 +168,7 @@ fn segment<V: Vector>(a: DVec3, b: DVec3, t: f64) -> Res<WallBox<V>> {
         .map_or_else(|_| fail("wall(a, b) is for 2D worlds"), Ok)
 }
 
-fn dim_of<V: Vector>(_: &dyn Env<V>) -> usize {
+fn dim_of<V: Vector>(_: &Env<'_, V>) -> usize {
     V::DIM
 }
 
@@ -192,36 +193,27 @@ fn walls_around<V: Vector>(w: &mut World<V>, t: f64) -> Res<Array> {
     Ok(out)
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    let h = host.clone();
-    engine.register_fn("world", move |map: Map| make_world(&h, &map));
-    let h = host.clone();
-    engine.register_fn("load_kind", move |name: &str| -> Res<()> {
-        ensure_kind(&h, name).map(drop)
+pub(super) fn register(api: &mut Api) {
+    api.func("world", |h| move |map: Map| make_world(&h, &map));
+    api.kind_func("load_kind", |h| {
+        move |name: &str| -> Res<()> { ensure_kind(&h, name).map(drop) }
     });
 
-    let h = host.clone();
-    engine.register_fn(
-        "wall",
+    api.func("wall", |h| {
         move |_: &mut WorldRef, a: DVec3, b: DVec3| -> Res<CritterRef> {
             on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, DEFAULT_WALL_THICKNESS)))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "wall",
+        }
+    });
+    api.func("wall", |h| {
         move |_: &mut WorldRef, a: DVec3, b: DVec3, t: Dynamic| -> Res<CritterRef> {
             let t = num_or(&t, "wall thickness")?;
             on_world!(h, "wall", w => add_wall_2d_or_3d(w, segment(a, b, t)))
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("wall_box", move |_: &mut WorldRef, lo: DVec3, hi: DVec3| -> Res<CritterRef> {
+        }
+    });
+    api.func("wall_box", |h| move |_: &mut WorldRef, lo: DVec3, hi: DVec3| -> Res<CritterRef> {
         on_world!(h, "wall_box", w => add_wall_2d_or_3d(w, WallBox::aligned(from_svec(lo), from_svec(hi)).map_err(lib_err)))
     });
-    let h = host.clone();
-    engine.register_fn(
-        "wall_box",
+    api.func("wall_box", |h| {
         move |_: &mut WorldRef, center: DVec3, size: DVec3, angle: Dynamic| -> Res<CritterRef> {
             let angle = num_or(&angle, "wall_box angle")?;
             on_world!(h, "wall_box", w => {
@@ -229,25 +221,22 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 let wall = rotated_box(from_svec(center), size, rot);
                 add_wall_2d_or_3d(w, wall)
             })
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("walls_around", move |_: &mut WorldRef| -> Res<Array> {
-        on_world!(h, "walls_around", w => walls_around(w, DEFAULT_WALL_THICKNESS))
+        }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "walls_around",
+    api.func("walls_around", |h| {
+        move |_: &mut WorldRef| -> Res<Array> {
+            on_world!(h, "walls_around", w => walls_around(w, DEFAULT_WALL_THICKNESS))
+        }
+    });
+    api.func("walls_around", |h| {
         move |_: &mut WorldRef, t: Dynamic| -> Res<Array> {
             let t = num_or(&t, "wall thickness")?;
             on_world!(h, "walls_around", w => walls_around(w, t))
-        },
-    );
+        }
+    });
 
     // Spawning patterns (scene scripts; kinds load on first use).
-    let h = host.clone();
-    engine.register_fn(
-        "row",
+    api.kind_func("row", |h| {
         move |_: &mut WorldRef,
               kind: &str,
               start: DVec3,
@@ -257,11 +246,9 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
               -> Res<Array> {
             let positions = (0..count.max(0)).map(|i| start + step * i as f64);
             spawn_at(&h, kind, &map, positions)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "ring",
+        }
+    });
+    api.kind_func("ring", |h| {
         move |_: &mut WorldRef,
               kind: &str,
               center: DVec3,
@@ -275,11 +262,9 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 center + DVec3::new(r * a.cos(), r * a.sin(), 0.0)
             });
             spawn_at(&h, kind, &map, positions)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "grid",
+        }
+    });
+    api.kind_func("grid", |h| {
         move |_: &mut WorldRef,
               kind: &str,
               lo: DVec3,
@@ -307,11 +292,9 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 })
             });
             spawn_at(&h, kind, &map, positions)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "scatter",
+        }
+    });
+    api.kind_func("scatter", |h| {
         move |_: &mut WorldRef, kind: &str, count: INT, map: Map| -> Res<Array> {
             let kind = ensure_kind(&h, kind)?;
             let mut out = Array::new();
@@ -319,23 +302,18 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 out.push(on_world!(h, "scatter", w => scatter_one(w, &h, &kind, &map))?);
             }
             Ok(out)
-        },
-    );
-    let h = host.clone();
-    engine.register_fn(
-        "stop",
+        }
+    });
+    api.func("stop", |h| {
         move |_: &mut WorldRef, reason: Dynamic| -> Res<()> {
             *h.stop.borrow_mut() = Some(reason.to_string());
             Ok(())
-        },
-    );
+        }
+    });
     // spawn(kind, #{ ... }). `spawn` is a reserved word in rhai, so it is custom syntax: now
     // between steps (loading the kind on first use), queued inside a step.
-    let h = host.clone();
-    let registered = engine.register_custom_syntax(
-        ["spawn", "(", "$expr$", ",", "$expr$", ")"],
-        false,
-        move |ctx, inputs| {
+    let registered = api.kind_syntax(&["spawn", "(", "$expr$", ",", "$expr$", ")"], |h| {
+        Box::new(move |ctx, inputs| {
             // Errors raised here have no position of their own: give them the spawn's.
             let pos = inputs[0].position();
             spawn_syntax(&h, ctx, inputs).map_err(|mut e| {
@@ -344,8 +322,8 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
                 }
                 e
             })
-        },
-    );
+        })
+    });
     debug_assert!(registered.is_ok());
 }
 

@@ -112,7 +112,7 @@ fn on_overlap_of(map: &Map, default: OnOverlap) -> Res<OnOverlap> {
 
 /// Spawns from a script, now between steps or queued inside one.
 pub(crate) fn spawn_in<V: Vector>(
-    env: &mut dyn Env<V>,
+    env: &mut Env<'_, V>,
     host: &Host,
     kind: &str,
     map: &Map,
@@ -122,7 +122,7 @@ pub(crate) fn spawn_in<V: Vector>(
 
 /// As [`spawn_in`]; a spawn queued inside a step keeps `origin` for its errors.
 pub(crate) fn spawn_from<V: Vector>(
-    env: &mut dyn Env<V>,
+    env: &mut Env<'_, V>,
     host: &Host,
     kind: &str,
     map: &Map,

@@ -3,11 +3,11 @@
 //! stays inside it, for every critter, so a step's scripts stop after a bounded amount of work,
 //! at the same operation on every machine (the count is rhai's, never a clock).
 
+use super::registry::Api;
 use super::HINT_MARK;
-use crate::script::host::{with_env, Host};
-use rhai::{Dynamic, Engine, EvalAltResult};
+use crate::script::host::with_env;
+use rhai::{Dynamic, EvalAltResult};
 use std::cell::Cell;
-use std::rc::Rc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
@@ -68,7 +68,7 @@ impl StepOps {
 /// Installs the budget of `max` operations per step on `engine` (none when `max` is 0);
 /// `charged` is the engine's total of operations charged for data walks
 /// (`Engine::set_data_walk_charge`).
-pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64, charged: Arc<AtomicU64>) {
+pub(super) fn install(api: &mut Api, max: u64, charged: Arc<AtomicU64>) {
     if max == 0 {
         return;
     }
@@ -78,8 +78,8 @@ pub(super) fn install(engine: &mut Engine, host: &Rc<Host>, max: u64, charged: A
         spent: Cell::new(0),
         charged: Cell::new(0),
     };
-    let h = host.clone();
-    engine.on_progress(move |n| {
+    let h = api.host();
+    api.engine.on_progress(move |n| {
         let step_now = || with_env!(h, env => Ok::<_, Box<EvalAltResult>>(env.step_count())).ok();
         ops.count(n, charged.load(Ordering::Relaxed), step_now)
             .map(Dynamic::from)

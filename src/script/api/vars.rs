@@ -5,12 +5,12 @@
 //! bools, strings, `Vec`s, critters, arrays and maps of those); the map is part of the state hash
 //! and of the recording.
 
+use super::registry::Api;
 use super::values::{from_prop, to_prop};
 use super::world::WorldRef;
 use super::{fail, fail_hint, Res};
 use crate::script::host::{with_env, Host};
-use rhai::{Array, Dynamic, Engine, Map, INT};
-use std::rc::Rc;
+use rhai::{Array, Dynamic, Map, INT};
 
 /// A handle to the world's vars, as scripts see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,67 +48,62 @@ fn set(host: &Host, name: &str, value: &Dynamic) -> Res<()> {
     })
 }
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
-    engine.register_type_with_name::<VarsRef>("Vars");
-    engine.register_get("vars", |_: &mut WorldRef| VarsRef);
+pub(super) fn register(api: &mut Api) {
+    api.engine.register_type_with_name::<VarsRef>("Vars");
+    api.engine.register_get("vars", |_: &mut WorldRef| VarsRef);
 
     // w.vars["name"], and w.vars.name through rhai's fallback from properties to the indexer.
-    let h = host.clone();
-    engine.register_indexer_get(move |_: &mut VarsRef, name: &str| get(&h, name));
-    let h = host.clone();
-    engine.register_indexer_set(move |_: &mut VarsRef, name: &str, value: Dynamic| {
-        set(&h, name, &value)
-    });
+    api.index_get(|h| move |_: &mut VarsRef, name: &str| get(&h, name));
+    api.index_set(|h| move |_: &mut VarsRef, name: &str, value: Dynamic| set(&h, name, &value));
     // rhai gives every value a `tag`; here, as for critters, it is a var like any other.
-    let h = host.clone();
-    engine.register_get("tag", move |_: &mut VarsRef| get(&h, "tag"));
-    let h = host.clone();
-    engine.register_set("tag", move |_: &mut VarsRef, value: Dynamic| {
-        set(&h, "tag", &value)
+    api.get("tag", |h| move |_: &mut VarsRef| get(&h, "tag"));
+    api.set("tag", |h| {
+        move |_: &mut VarsRef, value: Dynamic| set(&h, "tag", &value)
     });
 
-    let h = host.clone();
-    engine.register_fn("has", move |_: &mut VarsRef, name: &str| -> Res<bool> {
-        with_env!(h, env => match env.vars() {
-            Some(vars) => Ok(vars.contains_key(name)),
-            None => out_of_reach(),
-        })
+    api.func("has", |h| {
+        move |_: &mut VarsRef, name: &str| -> Res<bool> {
+            with_env!(h, env => match env.vars() {
+                Some(vars) => Ok(vars.contains_key(name)),
+                None => out_of_reach(),
+            })
+        }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "remove",
+    api.func("remove", |h| {
         move |_: &mut VarsRef, name: &str| -> Res<Dynamic> {
             with_env!(h, env => match env.vars() {
                 Some(vars) => Ok(vars.remove(name).map_or(Dynamic::UNIT, |v| from_prop(&v))),
                 None => out_of_reach(),
             })
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("keys", move |_: &mut VarsRef| -> Res<Array> {
-        with_env!(h, env => match env.vars() {
-            Some(vars) => Ok(vars.keys().map(|k| Dynamic::from(k.clone())).collect()),
-            None => out_of_reach(),
-        })
+        }
     });
-    let h = host.clone();
-    engine.register_fn("len", move |_: &mut VarsRef| -> Res<INT> {
-        with_env!(h, env => match env.vars() {
-            Some(vars) => Ok(vars.len() as INT),
-            None => out_of_reach(),
-        })
+    api.func("keys", |h| {
+        move |_: &mut VarsRef| -> Res<Array> {
+            with_env!(h, env => match env.vars() {
+                Some(vars) => Ok(vars.keys().map(|k| Dynamic::from(k.clone())).collect()),
+                None => out_of_reach(),
+            })
+        }
+    });
+    api.func("len", |h| {
+        move |_: &mut VarsRef| -> Res<INT> {
+            with_env!(h, env => match env.vars() {
+                Some(vars) => Ok(vars.len() as INT),
+                None => out_of_reach(),
+            })
+        }
     });
     // A copy of the whole map, to print or compare.
-    let h = host.clone();
+    let h = api.host();
     let to_map = move |_: &mut VarsRef| -> Res<Map> {
         with_env!(h, env => match env.vars() {
             Some(vars) => Ok(vars.iter().map(|(k, v)| (k.as_str().into(), from_prop(v))).collect()),
             None => out_of_reach(),
         })
     };
-    engine.register_fn("to_map", to_map.clone());
+    api.engine.register_fn("to_map", to_map.clone());
     let show =
         move |v: &mut VarsRef| -> Res<String> { to_map(v).map(|m| super::values::show(&m.into())) };
-    engine.register_fn("to_string", show.clone());
-    engine.register_fn("to_debug", show);
+    api.engine.register_fn("to_string", show.clone());
+    api.engine.register_fn("to_debug", show);
 }

@@ -2,26 +2,26 @@
 //! `w.critters_of(kind)`, `w.count(kind)`), and its log: `log(...)`, `print` and `debug`.
 
 use super::critter::CritterRef;
+use super::registry::Api;
 use super::Res;
-use crate::script::host::{with_env, Host};
-use rhai::{Array, Dynamic, Engine, EvalAltResult, INT};
-use std::rc::Rc;
+use crate::script::host::with_env;
+use rhai::{Array, Dynamic, EvalAltResult, INT};
 
 /// The running world, as scripts see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct WorldRef;
 
-pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
+pub(super) fn register(api: &mut Api) {
     // print and debug go to the run's log.
-    let h = host.clone();
-    engine.on_print(move |text| {
+    let h = api.host();
+    api.engine.on_print(move |text| {
         let _ = with_env!(h, env => {
             env.log(text.to_string());
             Ok::<(), Box<EvalAltResult>>(())
         });
     });
-    let h = host.clone();
-    engine.on_debug(move |text, source, pos| {
+    let h = api.host();
+    api.engine.on_debug(move |text, source, pos| {
         let line = match (source, pos.line()) {
             (Some(src), Some(l)) => format!("{src}:{l}: {text}"),
             _ => text.to_string(),
@@ -32,23 +32,18 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
         });
     });
 
-    engine.register_type_with_name::<WorldRef>("World");
-    engine.register_fn("world", || WorldRef);
-    let h = host.clone();
-    engine.register_get("step_count", move |_: &mut WorldRef| -> Res<INT> {
-        with_env!(h, env => Ok(env.step_count() as INT))
+    api.engine.register_type_with_name::<WorldRef>("World");
+    api.engine.register_fn("world", || WorldRef);
+    api.get("step_count", |h| {
+        move |_: &mut WorldRef| -> Res<INT> { with_env!(h, env => Ok(env.step_count() as INT)) }
     });
-    let h = host.clone();
-    engine.register_get("time", move |_: &mut WorldRef| -> Res<f64> {
-        with_env!(h, env => Ok(env.time()))
+    api.get("time", |h| {
+        move |_: &mut WorldRef| -> Res<f64> { with_env!(h, env => Ok(env.time())) }
     });
-    let h = host.clone();
-    engine.register_get("dt", move |_: &mut WorldRef| -> Res<f64> {
-        with_env!(h, env => Ok(env.dt()))
+    api.get("dt", |h| {
+        move |_: &mut WorldRef| -> Res<f64> { with_env!(h, env => Ok(env.dt())) }
     });
-    let h = host.clone();
-    engine.register_fn(
-        "critters_of",
+    api.kind_func("critters_of", |h| {
         move |_: &mut WorldRef, kind: &str| -> Res<Array> {
             let Some(k) = super::spawn::kind_for_query(&h, kind)? else {
                 return Ok(Array::new());
@@ -56,27 +51,30 @@ pub(super) fn register(engine: &mut Engine, host: &Rc<Host>) {
             with_env!(h, env => {
                 Ok(env.critters_of(k).into_iter().map(|id| Dynamic::from(CritterRef(id))).collect())
             })
-        },
-    );
-    let h = host.clone();
-    engine.register_fn("count", move |_: &mut WorldRef, kind: &str| -> Res<INT> {
-        let Some(k) = super::spawn::kind_for_query(&h, kind)? else {
-            return Ok(0);
-        };
-        with_env!(h, env => Ok(env.critters_of(k).len() as INT))
+        }
     });
-    let h = host.clone();
-    engine.register_fn("log", move |_: &mut WorldRef, line: Dynamic| -> Res<()> {
-        with_env!(h, env => {
-            env.log(line.to_string());
-            Ok(())
-        })
+    api.kind_func("count", |h| {
+        move |_: &mut WorldRef, kind: &str| -> Res<INT> {
+            let Some(k) = super::spawn::kind_for_query(&h, kind)? else {
+                return Ok(0);
+            };
+            with_env!(h, env => Ok(env.critters_of(k).len() as INT))
+        }
     });
-    let h = host.clone();
-    engine.register_fn("log", move |line: Dynamic| -> Res<()> {
-        with_env!(h, env => {
-            env.log(line.to_string());
-            Ok(())
-        })
+    api.func("log", |h| {
+        move |_: &mut WorldRef, line: Dynamic| -> Res<()> {
+            with_env!(h, env => {
+                env.log(line.to_string());
+                Ok(())
+            })
+        }
+    });
+    api.func("log", |h| {
+        move |line: Dynamic| -> Res<()> {
+            with_env!(h, env => {
+                env.log(line.to_string());
+                Ok(())
+            })
+        }
     });
 }
