@@ -125,6 +125,10 @@ impl<V: Vector> Access<'_, V> {
     pub fn dt(&self) -> f64 {
         self.state.dt
     }
+    /// The acceleration every moving critter falls with.
+    pub fn gravity(&self) -> V {
+        self.state.gravity
+    }
     /// The world's seeded generator.
     pub fn rng(&mut self) -> &mut Rng {
         &mut self.state.rng

@@ -1,10 +1,13 @@
 //! `World`: the running world as scripts see it (`world()`, `w.step_count`, `w.time`, `w.dt`,
+//! `w.gravity`,
 //! `w.critters_of(kind)`, `w.count(kind)`), and its log: `log(...)`, `print` and `debug`.
 
 use super::critter::CritterRef;
 use super::registry::Api;
-use super::Res;
+use super::values::to_svec;
+use super::{error, Res};
 use crate::script::host::with_env;
+use glam::DVec3;
 use rhai::{Array, Dynamic, EvalAltResult, INT};
 
 /// The running world, as scripts see it.
@@ -42,6 +45,11 @@ pub(super) fn register(api: &mut Api) {
     });
     api.get("dt", |h| {
         move |_: &mut WorldRef| -> Res<f64> { with_env!(h, env => Ok(env.dt())) }
+    });
+    api.get("gravity", |h| {
+        move |_: &mut WorldRef| -> Res<DVec3> {
+            with_env!(h, env => Ok(to_svec(env.access().map_err(error)?.gravity())))
+        }
     });
     api.kind_func("critters_of", |h| {
         move |_: &mut WorldRef, kind: &str| -> Res<Array> {
