@@ -143,12 +143,7 @@ impl<V: Vector> Access<'_, V> {
     }
     /// Seconds since critter `id` was spawned (see [`crate::world::World::age`]).
     pub fn age(&self, id: CritterId) -> Option<f64> {
-        self.state.critters.get(id)?;
-        Some(
-            self.state
-                .births
-                .age(id, self.state.step_count, self.state.dt),
-        )
+        self.state.age(id)
     }
     /// True when critter `id` is of kind `kind` or a kind that extends it.
     pub fn is_kind(&self, id: CritterId, kind: KindId) -> bool {

@@ -53,6 +53,13 @@ impl<V: Vector> State<V> {
         Access { state: self }
     }
 
+    /// Seconds of simulated time since critter `id` was spawned: the steps begun since then
+    /// times dt (0 in its `init`).
+    pub(crate) fn age(&self, id: CritterId) -> Option<f64> {
+        self.critters.get(id)?;
+        Some(self.births.age(id, self.step_count, self.dt))
+    }
+
     /// Runs critter `id`'s `init` hook.
     pub(crate) fn run_init(&mut self, id: CritterId) -> Result<(), Error> {
         let step = self.step_count;

@@ -279,12 +279,7 @@ impl<V: Vector> World<V> {
     /// Seconds of simulated time since critter `id` was spawned: the steps begun since then
     /// times dt (0 in its `init`).
     pub fn age(&self, id: CritterId) -> Option<f64> {
-        self.state.critters.get(id)?;
-        Some(
-            self.state
-                .births
-                .age(id, self.state.step_count, self.state.dt),
-        )
+        self.state.age(id)
     }
     /// Number of live critters of each kind, by name.
     pub fn count_by_kind(&self) -> BTreeMap<String, usize> {

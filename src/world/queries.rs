@@ -4,7 +4,6 @@
 use super::World;
 use crate::critter::CritterId;
 use crate::kind::KindId;
-use crate::step::neighbours::Filter;
 use crate::vector::Vector;
 
 impl<V: Vector> World<V> {
@@ -18,8 +17,7 @@ impl<V: Vector> World<V> {
         kind: Option<KindId>,
         exclude: Option<CritterId>,
     ) -> Vec<CritterId> {
-        let (grid, at) = self.state.scope();
-        grid.nearby(at, centre, r, Filter { kind, exclude })
+        self.access().nearby(centre, r, kind, exclude)
     }
 
     /// The live critter other than walls nearest to `centre`, of `kind` (or a kind extending
@@ -30,8 +28,7 @@ impl<V: Vector> World<V> {
         kind: Option<KindId>,
         exclude: Option<CritterId>,
     ) -> Option<CritterId> {
-        let (grid, at) = self.state.scope();
-        grid.nearest(at, centre, Filter { kind, exclude })
+        self.access().nearest(centre, kind, exclude)
     }
 
     /// True when a disk of radius `r` at `p` would overlap a critter other than a wall (live
