@@ -102,6 +102,9 @@ fn apply_sets(path: &str, text: &str, sets: &[(String, String)]) -> Result<Strin
     })
 }
 
+/// `--set NAME=VALUE` pairs, as (NAME, VALUE).
+type Sets = Vec<(String, String)>;
+
 /// A `--set KIND.NAME=VALUE`: the kind's constant `NAME`.
 struct KindSet {
     kind: String,
@@ -110,10 +113,7 @@ struct KindSet {
 }
 
 /// The sets of the scene's constants (`NAME`) and those of its kinds' (`KIND.NAME`).
-fn split_sets(
-    file: &str,
-    sets: &[(String, String)],
-) -> Result<(Vec<(String, String)>, Vec<KindSet>), Error> {
+fn split_sets(file: &str, sets: &[(String, String)]) -> Result<(Sets, Vec<KindSet>), Error> {
     let mut scene = Vec::new();
     let mut kinds = Vec::new();
     for (key, value) in sets {
