@@ -173,21 +173,32 @@ pub(crate) fn define(
     text: String,
 ) -> Result<Rc<ScriptKindDef>, Error> {
     let def = build(rt, file.clone(), name.clone(), &text)?;
-    rt.sources
-        .borrow_mut()
-        .push(SourceFile { path: file, text });
+    // The text built from, with any `--set KIND.NAME` in it, is what a replay needs.
+    rt.sources.borrow_mut().push(SourceFile {
+        path: file,
+        text: def.text.to_string(),
+    });
     rt.kinds.borrow_mut().insert(name, def.clone());
     Ok(def)
 }
 
-/// The kind `name` built from `text`, the text of its file `file`, its parents loaded; not yet
-/// among the runtime's kinds.
+/// The kind `name` built from `text`, the text of its file `file` (with the constants
+/// `--set KIND.NAME` gives it set), its parents loaded; not yet among the runtime's kinds.
 pub(crate) fn build(
     rt: &Runtime,
     file: String,
     name: String,
     text: &str,
 ) -> Result<Rc<ScriptKindDef>, Error> {
+    let sets = rt.kind_sets.borrow().get(&name).cloned();
+    let set_text;
+    let text = match sets {
+        Some(sets) => {
+            set_text = super::scene::kind_constant_set(&file, &name, text, &sets)?;
+            set_text.as_str()
+        }
+        None => text,
+    };
     let ast = rt
         .compile(&file, text)
         .map_err(|e| in_kind(e, &file, &name))?;

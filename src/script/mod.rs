@@ -104,6 +104,9 @@ pub(crate) struct Runtime {
     pub kinds: RefCell<BTreeMap<String, Rc<kind_file::ScriptKindDef>>>,
     /// Every file loaded, in load order.
     pub sources: RefCell<Vec<SourceFile>>,
+    /// The constants `--set KIND.NAME=VALUE` gives, by kind: applied to the kind's text each
+    /// time it is built (loaded or reloaded), so its sources and recordings hold the values.
+    pub kind_sets: RefCell<BTreeMap<String, Vec<(String, String)>>>,
     /// The limits the engine was built with.
     pub limits: Limits,
     /// Whether a kind name has a file on the kind search path, once asked (see
@@ -160,6 +163,7 @@ impl Runtime {
                 kind_dirs,
                 kinds: RefCell::new(BTreeMap::new()),
                 sources: RefCell::new(Vec::new()),
+                kind_sets: RefCell::new(BTreeMap::new()),
                 limits: options.limits.clone(),
                 kind_files: RefCell::new(BTreeMap::new()),
                 unknown_warned: RefCell::new(Default::default()),
@@ -225,7 +229,7 @@ impl Runtime {
         let mut ast = self
             .engine
             .compile(text)
-            .map_err(|e| Error::from(errors::parse_error(path, &e)))?;
+            .map_err(|e| Error::from(errors::parse_error(path, text, &e)))?;
         ast.set_source(path);
         Ok(ast)
     }
@@ -262,6 +266,26 @@ pub fn load_scene_keeping_sources(
     options: &ScriptOptions,
 ) -> Result<Scene, (Error, Vec<SourceFile>)> {
     scene::load_keeping_sources(path, sets, options)
+}
+
+/// The text of kind `kind` (file `file`) as a run given `sets` builds it: with the constants
+/// its `KIND.NAME=VALUE` sets name replaced, as they are when it is loaded or reloaded. A
+/// recording of a reload keeps this text, so that the replay makes the same kind.
+pub fn kind_text_with_sets(
+    file: &str,
+    kind: &str,
+    text: &str,
+    sets: &[(String, String)],
+) -> Result<String, Error> {
+    let prefix = format!("{kind}.");
+    let own: Vec<(String, String)> = sets
+        .iter()
+        .filter_map(|(k, v)| Some((k.strip_prefix(&prefix)?.to_string(), v.clone())))
+        .collect();
+    if own.is_empty() {
+        return Ok(text.to_string());
+    }
+    scene::kind_constant_set(file, kind, text, &own)
 }
 
 /// A world that script kinds can be loaded into: `World<DVec2>` and `World<DVec3>`.

@@ -21,19 +21,41 @@ pub(crate) fn looks_like_scene(text: &str) -> bool {
     })
 }
 
-/// Replaces the value of `const NAME = ...;` at the top level for each override.
-fn apply_sets(path: &str, text: &str, sets: &[(String, String)]) -> Result<String, Error> {
+/// The names of the `const NAME = ...;` lines of `text`.
+pub(crate) fn constants_of(text: &str) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("const "))
+        .filter_map(|r| {
+            r.trim_start()
+                .split(|c: char| c == '=' || c == ':' || c.is_whitespace())
+                .next()
+        })
+        .filter(|n| !n.is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+/// A `--set` value as rhai source: numbers, `true`, `false` and quoted strings as they are,
+/// anything else as a string.
+fn literal(value: &str) -> String {
+    if value.parse::<f64>().is_ok() || value == "true" || value == "false" || value.starts_with('"')
+    {
+        value.to_string()
+    } else {
+        format!("{value:?}")
+    }
+}
+
+/// `text` with the value of its `const NAME = ...;` replaced for each (NAME, VALUE) of `sets`;
+/// `missing(name)` is the error of a name it declares no constant of.
+pub(crate) fn set_constants(
+    text: &str,
+    sets: &[(String, String)],
+    missing: impl Fn(&str) -> Error,
+) -> Result<String, Error> {
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     for (name, value) in sets {
-        let literal = if value.parse::<f64>().is_ok()
-            || value == "true"
-            || value == "false"
-            || value.starts_with('"')
-        {
-            value.clone()
-        } else {
-            format!("{value:?}")
-        };
+        let literal = literal(value);
         let mut found = false;
         for line in &mut lines {
             let t = line.trim_start();
@@ -52,25 +74,146 @@ fn apply_sets(path: &str, text: &str, sets: &[(String, String)]) -> Result<Strin
             }
         }
         if !found {
-            let consts: Vec<String> = text
-                .lines()
-                .filter_map(|l| l.trim_start().strip_prefix("const "))
-                .filter_map(|r| r.split(|c: char| c == '=' || c.is_whitespace()).next())
-                .map(str::to_string)
-                .collect();
-            let mut e = ScriptError::new(
-                path,
-                format!("--set {name}: the scene has no constant {name}"),
-            );
-            e.hint = Some(if consts.is_empty() {
-                "this scene declares no constants to set".into()
-            } else {
-                format!("its constants are {}", consts.join(", "))
-            });
-            return Err(Error::from(e));
+            return Err(missing(name));
         }
     }
     Ok(lines.join("\n"))
+}
+
+/// "its constants are A, B", or that it has none: the hint of a `--set` of no constant.
+pub(crate) fn constants_hint(what: &str, text: &str) -> String {
+    let consts = constants_of(text);
+    if consts.is_empty() {
+        format!("{what} declares no constants to set")
+    } else {
+        format!("its constants are {}", consts.join(", "))
+    }
+}
+
+/// Replaces the value of `const NAME = ...;` at the top level for each override.
+fn apply_sets(path: &str, text: &str, sets: &[(String, String)]) -> Result<String, Error> {
+    set_constants(text, sets, |name| {
+        let mut e = ScriptError::new(
+            path,
+            format!("--set {name}: the scene has no constant {name}"),
+        );
+        e.hint = Some(constants_hint("this scene", text));
+        Error::from(e)
+    })
+}
+
+/// `--set NAME=VALUE` pairs, as (NAME, VALUE).
+type Sets = Vec<(String, String)>;
+
+/// A `--set KIND.NAME=VALUE`: the kind's constant `NAME`.
+struct KindSet {
+    kind: String,
+    name: String,
+    value: String,
+}
+
+/// The sets of the scene's constants (`NAME`) and those of its kinds' (`KIND.NAME`).
+fn split_sets(file: &str, sets: &[(String, String)]) -> Result<(Sets, Vec<KindSet>), Error> {
+    let mut scene = Vec::new();
+    let mut kinds = Vec::new();
+    for (key, value) in sets {
+        match key.split_once('.') {
+            None => scene.push((key.clone(), value.clone())),
+            Some((kind, name)) if !kind.is_empty() && !name.is_empty() && !name.contains('.') => {
+                kinds.push(KindSet {
+                    kind: kind.to_string(),
+                    name: name.to_string(),
+                    value: value.clone(),
+                })
+            }
+            Some(_) => {
+                let mut e = ScriptError::new(file, format!("--set {key}: not a constant's name"));
+                e.hint = Some(
+                    "write NAME=VALUE for the scene's constant, KIND.NAME=VALUE for a kind's \
+                     (--set SPEED=2, --set boid.SIGHT=3)"
+                        .into(),
+                );
+                return Err(Error::from(e));
+            }
+        }
+    }
+    Ok((scene, kinds))
+}
+
+/// The error of a `--set KIND.NAME` whose kind is no script kind of this run.
+fn unknown_kind_set(rt: &Runtime, file: &str, set: &KindSet) -> Error {
+    let KindSet { kind, name, .. } = set;
+    if super::kind_refs::NATIVE_KINDS.contains(&kind.as_str()) {
+        let mut e = ScriptError::new(
+            file,
+            format!("--set {kind}.{name}: '{kind}' is a native kind, it has no constants"),
+        );
+        e.hint = Some("only script kinds (scripts/kinds/NAME.rhai) have constants to set".into());
+        return Error::from(e);
+    }
+    let known: Vec<String> = rt
+        .known_kind_names()
+        .into_iter()
+        .filter(|k| !super::kind_refs::NATIVE_KINDS.contains(&k.as_str()))
+        .collect();
+    let mut e = ScriptError::new(
+        file,
+        format!("--set {kind}.{name}: no kind '{kind}' in this run"),
+    );
+    let near = super::kind_refs::closest(kind, known.iter().map(String::as_str));
+    e.hint = Some(match near {
+        Some(k) => format!(
+            "did you mean '{k}'? The script kinds found are {}",
+            known.join(", ")
+        ),
+        None if known.is_empty() => "no script kinds were found on the kind search path".into(),
+        None => format!("the script kinds found are {}", known.join(", ")),
+    });
+    Error::from(e)
+}
+
+/// Checks the kinds' sets whose kind files are on the search path (their constants exist), and
+/// gives them to the runtime, which applies them to each kind's text as it is built.
+fn give_kind_sets(rt: &Runtime, file: &str, sets: &[KindSet]) -> Result<(), Error> {
+    for set in sets {
+        if super::kind_refs::NATIVE_KINDS.contains(&set.kind.as_str()) {
+            return Err(unknown_kind_set(rt, file, set));
+        }
+        if let Some(path) = rt.resolve_kind(&set.kind) {
+            let text = read_script(&path)?;
+            let kind_file = path.display().to_string();
+            kind_constant_set(
+                &kind_file,
+                &set.kind,
+                &text,
+                &[(set.name.clone(), set.value.clone())],
+            )?;
+        }
+        rt.kind_sets
+            .borrow_mut()
+            .entry(set.kind.clone())
+            .or_default()
+            .push((set.name.clone(), set.value.clone()));
+    }
+    Ok(())
+}
+
+/// The text of kind `kind` (its file `file`) with its constants set as `sets` say.
+pub(crate) fn kind_constant_set(
+    file: &str,
+    kind: &str,
+    text: &str,
+    sets: &[(String, String)],
+) -> Result<String, Error> {
+    set_constants(text, sets, |name| {
+        let mut e = ScriptError::new(
+            file,
+            format!("--set {kind}.{name}: the kind '{kind}' has no constant {name}"),
+        );
+        e.kind = Some(kind.to_string());
+        e.hint = Some(constants_hint("this kind", text));
+        Error::from(e)
+    })
 }
 
 /// Loads and sets up a scene script.
@@ -91,19 +234,32 @@ pub(crate) fn load_keeping_sources(
 ) -> Result<Scene, (Error, Vec<SourceFile>)> {
     let file = path.display().to_string();
     let raw = read_script(path).map_err(|e| (e, Vec::new()))?;
-    let text = apply_sets(&file, &raw, sets).map_err(|e| {
+    let scene_only = |e: Error| {
         let scene = SourceFile {
             path: file.clone(),
             text: raw.clone(),
         };
         (e, vec![scene])
-    })?;
+    };
+    let (scene_sets, kind_sets) = split_sets(&file, sets).map_err(scene_only)?;
+    let text = apply_sets(&file, &raw, &scene_sets).map_err(scene_only)?;
     let rt = Runtime::new(options, path.parent());
+    give_kind_sets(&rt, &file, &kind_sets).map_err(scene_only)?;
     rt.sources.borrow_mut().push(SourceFile {
         path: file.clone(),
         text: text.clone(),
     });
-    set_up(&rt, path, &file, &text).map_err(|e| {
+    let built = set_up(&rt, path, &file, &text).and_then(|scene| {
+        // A kind not found by name on the search path may have been loaded by its path.
+        let unknown = |s: &&KindSet| {
+            !rt.kinds.borrow().contains_key(&s.kind) && rt.resolve_kind(&s.kind).is_none()
+        };
+        match kind_sets.iter().find(unknown) {
+            Some(set) => Err(unknown_kind_set(&rt, &file, set)),
+            None => Ok(scene),
+        }
+    });
+    built.map_err(|e| {
         let mut read = rt.sources.borrow().clone();
         // A kind file that failed to compile or load is kept only once it loads: add its text.
         if let Error::Script(s) = &e {
@@ -248,5 +404,50 @@ impl OnStep {
             Error::from(err)
         })?;
         Ok(self.rt.host.stop.borrow_mut().take())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const KIND: &str = "const SIGHT = 5.0; // how far\nconst SIGHT2 = 1;\nfn update(me, dt) {}\n";
+
+    #[test]
+    fn a_kinds_sets_replace_its_constants_and_leave_the_rest() {
+        let sets = [
+            ("boid.SIGHT".to_string(), "3".to_string()),
+            ("N".to_string(), "7".to_string()),
+            ("other.SIGHT".to_string(), "9".to_string()),
+        ];
+        let text = crate::script::kind_text_with_sets("boid.rhai", "boid", KIND, &sets)
+            .expect("boid has SIGHT");
+        assert!(text.starts_with("const SIGHT = 3; // how far\n"), "{text}");
+        assert!(text.contains("const SIGHT2 = 1;"), "{text}");
+        let plain =
+            crate::script::kind_text_with_sets("x.rhai", "x", KIND, &sets).expect("no sets");
+        assert_eq!(plain, KIND, "a kind no set names keeps its text");
+    }
+
+    #[test]
+    fn a_kinds_set_of_no_constant_names_the_kind_and_its_constants() {
+        let sets = [("boid.SPEED".to_string(), "3".to_string())];
+        let err = crate::script::kind_text_with_sets("boid.rhai", "boid", KIND, &sets)
+            .expect_err("boid has no SPEED");
+        let shown = err.to_string();
+        assert!(shown.contains("boid.rhai"), "{shown}");
+        assert!(
+            shown.contains("the kind 'boid' has no constant SPEED"),
+            "{shown}"
+        );
+        assert!(shown.contains("its constants are SIGHT, SIGHT2"), "{shown}");
+    }
+
+    #[test]
+    fn a_set_value_that_is_no_number_or_bool_is_a_string() {
+        assert_eq!(literal("2.5"), "2.5");
+        assert_eq!(literal("true"), "true");
+        assert_eq!(literal("\"x\""), "\"x\"");
+        assert_eq!(literal("wide"), "\"wide\"");
     }
 }

@@ -20,7 +20,8 @@ step, with the recording finished (end record `interrupted`, naming the signal).
 pub struct RunArgs {
     /// A scene script (scripts/scenes/NAME.rhai) or a built-in scene (see --list). Default: gas.
     pub scene: Option<String>,
-    /// Override a scene script's constant: --set SPEED=20 (repeatable).
+    /// Override a scene script's constant, --set SPEED=20, or a kind's, --set boid.SIGHT=3
+    /// (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub sets: Vec<String>,
     /// Most operations one script call may run before it is stopped (endless-loop guard).
@@ -171,6 +172,8 @@ pub fn run_once(
     let started = Instant::now();
     let mut stopped = None;
     let mut scene_changed = false;
+    // The kind files reloaded under --watch, with the step after which each was.
+    let mut reloads: Vec<(u64, String)> = Vec::new();
     // Time the simulation thread spends recording (hash, totals, events, handing them over).
     let mut recording = Duration::ZERO;
     for i in 0..steps {
@@ -205,6 +208,15 @@ pub fn run_once(
         }) {
             Ok(outcome) => outcome,
             Err(e) => {
+                // A kind reloaded under --watch that fails stops the run (watch.rs says
+                // why): the error says so, naming the reload.
+                let e = match reloaded_cause(&e, &reloads) {
+                    Some((at, file)) => e.context(format!(
+                        "watch: {file} was reloaded after step {at} and its new version failed; \
+                         the run stopped (fix the file and save it: the scene runs again from step 0)"
+                    )),
+                    None => e,
+                };
                 // The error goes into the recording, which is closed before it is reported.
                 bar.finish_and_clear();
                 record::fail(recorder.take(), &scene, &e, out)?;
@@ -229,15 +241,26 @@ pub fn run_once(
             let changed = w.changed();
             let file = scene_file.as_deref();
             let edits = if changed.is_empty() {
-                Edits::Applied
+                Edits::Applied(Vec::new())
             } else {
-                bar.suspend(|| apply(changed, &mut scene, &mut recorder, &mut viewer, file))?
+                let sets = parse_sets(args).unwrap_or_default();
+                let edit = Edit {
+                    scene_file: file,
+                    sets: &sets,
+                };
+                bar.suspend(|| apply(changed, &mut scene, &mut recorder, &mut viewer, &edit))?
             };
-            if edits == Edits::SceneChanged {
-                let reason = "its scene file changed (--watch)".to_string();
-                stopped = Some((scene.world.step_count(), reason));
-                scene_changed = true;
-                break;
+            match edits {
+                Edits::SceneChanged => {
+                    let reason = "its scene file changed (--watch)".to_string();
+                    stopped = Some((scene.world.step_count(), reason));
+                    scene_changed = true;
+                    break;
+                }
+                Edits::Applied(files) => {
+                    let at = scene.world.step_count();
+                    reloads.extend(files.into_iter().map(|f| (at, f)));
+                }
             }
         }
         if i % 16 == 15 {
@@ -347,13 +370,35 @@ pub fn run_once(
     })
 }
 
+/// The reload (step, file) a failed step's error comes from: the last reload of the file the
+/// script error names.
+fn reloaded_cause<'a>(
+    e: &anyhow::Error,
+    reloads: &'a [(u64, String)],
+) -> Option<&'a (u64, String)> {
+    let file = e
+        .chain()
+        .find_map(|c| match c.downcast_ref::<critterbox::Error>() {
+            Some(critterbox::Error::Script(s)) => Some(s.file.clone()),
+            _ => None,
+        })?;
+    reloads.iter().rev().find(|(_, f)| *f == file)
+}
+
 /// What the watched files' edits did between two steps.
-#[derive(PartialEq)]
 enum Edits {
-    /// Nothing, or kinds reloaded (or edits that did not compile, reported).
-    Applied,
+    /// Nothing, or the kind files it names reloaded (edits that did not compile are reported
+    /// and change nothing).
+    Applied(Vec<String>),
     /// The scene file changed: the run starts again.
     SceneChanged,
+}
+
+/// What [`apply`] needs of the run: its scene file, and its `--set`s (a kind's are in its
+/// reloaded text too).
+struct Edit<'a> {
+    scene_file: Option<&'a str>,
+    sets: &'a [(String, String)],
 }
 
 /// Applies edits of the watched files (path as loaded, new text) between two steps: a kind
@@ -364,11 +409,12 @@ fn apply(
     scene: &mut Scene,
     recorder: &mut Option<record::RunRecording>,
     viewer: &mut super::view::Viewer,
-    scene_file: Option<&str>,
+    edit: &Edit,
 ) -> anyhow::Result<Edits> {
     let step = scene.world.step_count();
+    let mut reloaded = Vec::new();
     for (file, text) in changed {
-        if Some(file.as_str()) == scene_file {
+        if Some(file.as_str()) == edit.scene_file {
             return Ok(Edits::SceneChanged);
         }
         match scene.reload_kind(&file, &text) {
@@ -380,15 +426,23 @@ fn apply(
                 eprintln!("{line}");
                 viewer.note(line);
                 if let Some(r) = recorder {
-                    r.reload(scene, &file, &text, kinds)?;
+                    // The text the kind was built from: with its --set constants in it.
+                    let built = match kinds.first() {
+                        Some(kind) => {
+                            critterbox::script::kind_text_with_sets(&file, kind, &text, edit.sets)?
+                        }
+                        None => text.clone(),
+                    };
+                    r.reload(scene, &file, &built, kinds)?;
                 }
+                reloaded.push(file);
             }
             Err(e) => eprintln!(
                 "watch: after step {step}: {file} not reloaded, the old version runs on: {e}"
             ),
         }
     }
-    Ok(Edits::Applied)
+    Ok(Edits::Applied(reloaded))
 }
 
 /// Why no scene came out of [`load`].
@@ -467,14 +521,7 @@ fn load(args: &RunArgs) -> Result<Scene, Unloaded> {
             "-n works on built-in scenes; a scene script sets its own counts (use --set NAME=VALUE)"
         )));
     }
-    let mut sets = Vec::new();
-    for s in &args.sets {
-        let (k, v) = s
-            .split_once('=')
-            .with_context(|| format!("--set {s}: write NAME=VALUE, e.g. --set SPEED=20"))
-            .map_err(usage)?;
-        sets.push((k.trim().to_string(), v.trim().to_string()));
-    }
+    let sets = parse_sets(args).map_err(usage)?;
     let options = ScriptOptions {
         limits: limits(args),
         seed: args.seed,
@@ -497,6 +544,21 @@ fn load(args: &RunArgs) -> Result<Scene, Unloaded> {
             }
         },
     )
+}
+
+/// The `--set NAME=VALUE` and `--set KIND.NAME=VALUE` pairs.
+fn parse_sets(args: &RunArgs) -> anyhow::Result<Vec<(String, String)>> {
+    let mut sets = Vec::new();
+    for s in &args.sets {
+        let (k, v) = s.split_once('=').with_context(|| {
+            format!(
+                "--set {s}: write NAME=VALUE for a scene constant or KIND.NAME=VALUE for a \
+                 kind's, e.g. --set SPEED=20 or --set boid.SIGHT=3"
+            )
+        })?;
+        sets.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    Ok(sets)
 }
 
 /// Whether the run times its hooks (critterbox::profile): with `--stats`, whose table it feeds,
@@ -586,6 +648,15 @@ fn summary(
         world.dt()
     )?;
     writeln!(out, "critters     {}", counts.join(", "))?;
+    // The scripts' shared state, as `--summary-json` writes it (values as JSON).
+    let vars = world.vars();
+    if !vars.is_empty() {
+        let shown: Vec<String> = vars
+            .iter()
+            .map(|(k, v)| format!("{k} = {}", critterbox::sweep::prop_to_json(v)))
+            .collect();
+        writeln!(out, "vars         {}", shown.join(", "))?;
+    }
     writeln!(
         out,
         "collisions   {} impacts ({:.2} per step), {} contacts handled",

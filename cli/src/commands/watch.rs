@@ -1,6 +1,9 @@
 //! `run --watch`: the script files a run loaded, watched for edits. A kind file's new text
 //! replaces its kind at the next step boundary (hot reload, recorded); the scene file's runs the
-//! scene again from step 0; a file that does not compile leaves the old version running.
+//! scene again from step 0; a file that does not compile leaves the old version running. A
+//! reloaded kind that fails while running stops the run, as any failing step does: the step
+//! cannot be taken back, so there is no old version to go on with. The error names the reload
+//! (`run::run_once`), and the next edit runs the scene again.
 //!
 //! The folders of the files are watched (inotify, through `notify`), not the files, so an
 //! editor that saves by writing a new file and renaming it over the old one is seen too. Events

@@ -14,6 +14,7 @@ mod cli;
 mod damaged;
 mod recording;
 mod script_state;
+mod sets;
 mod state_hashes;
 mod stops;
 mod sweep;

@@ -207,3 +207,98 @@ fn a_built_in_scene_has_nothing_to_watch_and_the_watch_ends() {
     assert!(out.status.success(), "{err}");
     assert!(err.contains("nothing to watch"), "{err}");
 }
+
+/// Starts `critterbox run SCENE --watch` for a long run, recorded to `file`; its stderr lines
+/// come through the receiver.
+fn watching(scene: &Path, file: &Path) -> (std::process::Child, Receiver<String>) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_critterbox"))
+        .args(["run", scene.to_str().expect("utf-8"), "--watch"])
+        .args([
+            "--steps",
+            "100000000",
+            "--record",
+            file.to_str().expect("utf-8"),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let stderr = child.stderr.take().expect("stderr");
+    let (tx, lines) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    (child, lines)
+}
+
+#[test]
+fn an_unclosed_brace_in_an_edit_is_placed_at_the_brace_not_the_end_of_the_file() {
+    let dir = common::tmp_in("watch-tests", "unclosed");
+    let scene = setup(&dir);
+    let file = dir.join("run.mcap");
+    let (mut child, lines) = watching(&scene, &file);
+    common::wait_until_stepping(&file);
+    let kind = dir.join("kinds/mover.rhai");
+    let mut seen = Vec::new();
+    // The `if` on line 3 is never closed; rhai notices only at the end of the file (line 6).
+    std::fs::write(
+        &kind,
+        "defaults(#{ radius: 0.5 });\nfn update(me, dt) {\n    if me.pos.x > 1.0 {\n        \
+         me.vel = vec(0.0, 1.0);\n}\n",
+    )
+    .expect("edit");
+    wait_for(&lines, "not reloaded, the old version runs on", &mut seen);
+    let line = seen.last().cloned().unwrap_or_default();
+    assert!(
+        line.contains("mover.rhai:3:23") && line.contains("never closed"),
+        "the error is at the `if`'s brace: {seen:#?}"
+    );
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let status = child.wait().expect("ends");
+    assert_eq!(status.code(), Some(130), "{seen:#?}");
+}
+
+#[test]
+fn a_reloaded_kind_that_fails_at_run_time_stops_the_run_and_an_edit_runs_it_again() {
+    let dir = common::tmp_in("watch-tests", "runtime");
+    let scene = setup(&dir);
+    let file = dir.join("run.mcap");
+    let (mut child, lines) = watching(&scene, &file);
+    common::wait_until_stepping(&file);
+    let kind = dir.join("kinds/mover.rhai");
+    let mut seen = Vec::new();
+    // It compiles, so it is reloaded; its update then reads a property nobody declared.
+    std::fs::write(
+        &kind,
+        "fn update(me, dt) {\n    me.vel = vec(1.0, 0.0) * me.missing;\n}\n",
+    )
+    .expect("edit");
+    wait_for(&lines, "reloaded (kind mover)", &mut seen);
+    wait_for(&lines, "its new version failed", &mut seen);
+    let line = seen.last().cloned().unwrap_or_default();
+    assert!(
+        line.contains("the run stopped") && line.contains("mover.rhai:2:"),
+        "names the reload and where its new version failed: {seen:#?}"
+    );
+    wait_for(&lines, "watching", &mut seen);
+    // The failed run is recorded as failed, the reload in it.
+    let rec = Recording::open(&file).expect("reads");
+    assert_eq!(rec.reloads.len(), 1, "{seen:#?}");
+    // Fixed: the scene runs again from step 0, with the fixed kind.
+    std::fs::write(&kind, KIND).expect("edit");
+    wait_for(&lines, "running the scene again", &mut seen);
+    common::wait_until_stepping(&dir.join("run-2.mcap"));
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let status = child.wait().expect("ends");
+    assert_eq!(
+        status.code(),
+        Some(130),
+        "Ctrl-C during the second run: {seen:#?}"
+    );
+}

@@ -5,10 +5,11 @@
 use super::registry::Api;
 use super::values::{from_prop, from_svec, num_or, to_prop, to_svec};
 use super::{error, fail, fail_hint, lib_err, Res};
+use crate::border::Topology;
 use crate::critter::{CritterId, PropValue};
 use crate::script::host::{with_env, Host};
 use crate::step::spawn::check_radius_in_box;
-use crate::vector::Vector;
+use crate::vector::{fmt_vec, Vector};
 use glam::DVec3;
 use rhai::{Dynamic, EvalAltResult, INT};
 
@@ -77,17 +78,91 @@ fn set_prop(host: &Host, id: CritterId, name: &str, value: &Dynamic, create: boo
         }
         let kind = c.kind();
         let kind = env.kinds().name(kind);
-        fail_hint(
-            format!(
-                "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
-                 health, restitution, priority, fixed)"
+        let message = format!(
+            "critter {id} ({kind}) has no property '{name}' (the fields are pos, vel, radius, mass, \
+             health, restitution, priority, fixed)"
+        );
+        match near_field(name) {
+            Some(field) => fail_hint(message, did_you_mean(name, field)),
+            None => fail_hint(
+                message,
+                format!(
+                    "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
+                     set_prop(\"{name}\", value)"
+                ),
             ),
-            format!(
-                "declare '{name}' in the kind's defaults props or the spawn map, or add it with \
-                 set_prop(\"{name}\", value)"
-            ),
-        )
+        }
     })
+}
+
+/// The fields every critter has (getters; the first eight can be set too).
+const FIELDS: &[&str] = &[
+    "pos",
+    "vel",
+    "radius",
+    "mass",
+    "health",
+    "restitution",
+    "priority",
+    "fixed",
+    "color",
+    "alive",
+    "id",
+    "kind",
+    "is_wall",
+    "age",
+];
+
+/// The field `name` is most likely a misspelling of: one a small edit away (`radus`), or one it
+/// spells out (`velocity`, `position`). A property of that name would be declared first, so an
+/// undeclared one that is this near a field is taken for a typo.
+fn near_field(name: &str) -> Option<&'static str> {
+    crate::script::kind_refs::closest(name, FIELDS.iter().copied()).or_else(|| {
+        FIELDS
+            .iter()
+            .copied()
+            .filter(|f| f.len() >= 3)
+            .filter(|f| {
+                name.strip_prefix(f).is_some_and(|rest| {
+                    !rest.is_empty() && rest.chars().all(|c| c.is_ascii_lowercase())
+                })
+            })
+            .max_by_key(|f| f.len())
+    })
+}
+
+/// The hint of an unknown property that is a near miss of `field`.
+fn did_you_mean(name: &str, field: &str) -> String {
+    format!(
+        "did you mean `{field}`? `{name}` is no field of a critter; the fields are {}",
+        FIELDS.join(", ")
+    )
+}
+
+/// `pos = p` on critter `c` in the box `topo`: wrapped into the box on a periodic border, an
+/// error naming the critter and the box outside it on any other (a spawn's centre must be in
+/// the box too; clamping it silently moved the critter somewhere the script never said).
+fn placed<V: Vector>(topo: &Topology<V>, who: impl Fn() -> String, v: DVec3) -> Res<V> {
+    let mut p = V::zero();
+    set_vec(&mut p, v, "pos")?;
+    if topo.wraps() {
+        return Ok(topo.wrap_position(p));
+    }
+    let outside = (0..V::DIM).any(|a| p.get(a) < topo.min.get(a) || p.get(a) > topo.max.get(a));
+    if outside {
+        let border = format!("{:?}", topo.border).to_lowercase();
+        return fail_hint(
+            format!(
+                "pos = {}: {} would be outside the world box {} to {} (border \"{border}\")",
+                fmt_vec(p),
+                who(),
+                fmt_vec(topo.min),
+                fmt_vec(topo.max),
+            ),
+            "keep pos inside the box; under border: \"wrap\" a position past one side comes back on the other",
+        );
+    }
+    Ok(p)
 }
 
 /// True when `a` and `b` are the same scalar, bit for bit (so `-0.0` differs from `0.0`);
@@ -171,7 +246,26 @@ pub(super) fn register(api: &mut Api) {
             }
         });
     }
-    critter_setter!(api, "pos", DVec3, |c, v| set_vec(&mut c.pos, v, "pos"));
+    api.set("pos", |h| {
+        move |r: &mut CritterRef, v: DVec3| -> Res<()> {
+            let id = r.0;
+            with_env!(h, env => {
+                let topo = *env.topology();
+                let who = match env.critter(id) {
+                    Some(c) => format!("{} ({})", c.describe(), env.kinds().name(c.kind())),
+                    None => return Err(gone(id)),
+                };
+                let p = placed(&topo, || who.clone(), v)?;
+                match env.critter_mut(id) {
+                    Some(c) => {
+                        c.pos = p;
+                        Ok(())
+                    }
+                    None => fail("critters are read-only in collides_with: pos cannot be set there"),
+                }
+            })
+        }
+    });
     critter_setter!(api, "vel", DVec3, |c, v| set_vec(&mut c.vel, v, "vel"));
     // A new radius must fit in the world box, as a spawn's must.
     api.set("radius", |h| {
@@ -258,9 +352,13 @@ pub(super) fn register(api: &mut Api) {
     api.index_get(|h| move |r: &mut CritterRef, name: &str| -> Res<Dynamic> {
         let id = r.0;
         with_env!(h, env => match env.critter(id) {
-            Some(c) => match c.props().get(name) {
-                Some(p) => Ok(from_prop(p)),
-                None => fail(format!(
+            Some(c) => match (c.props().get(name), near_field(name)) {
+                (Some(p), _) => Ok(from_prop(p)),
+                (None, Some(field)) => fail_hint(
+                    format!("critter {id} ({}) has no property '{name}'", env.kinds().name(c.kind())),
+                    did_you_mean(name, field),
+                ),
+                (None, None) => fail(format!(
                     "critter {id} ({}) has no property '{name}'; give it one in its kind's props or spawn map, or test with has(\"{name}\")",
                     env.kinds().name(c.kind())
                 )),

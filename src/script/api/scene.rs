@@ -7,13 +7,13 @@ use super::registry::Api;
 use super::spawn::{spawn_in, spec_from_map};
 use super::values::{from_svec, num, num_or, to_svec};
 use super::world::WorldRef;
-use super::{error, fail, lib_err, Res};
+use super::{error, fail, fail_hint, lib_err, Res};
 use crate::border::Border;
 use crate::scenes::{AnyWorld, Scene};
 use crate::script::env::Env;
 use crate::script::host::{with_env, Host};
 use crate::script::kind_file::load_into;
-use crate::vector::Vector;
+use crate::vector::{fmt_vec, Vector};
 use crate::wall::{WallBox, DEFAULT_WALL_THICKNESS};
 use crate::world::{World, WorldConfig};
 use glam::{DMat3, DVec2, DVec3};
@@ -42,6 +42,34 @@ fn ensure_kind(host: &Rc<Host>, name: &str) -> Res<String> {
             "unknown kind '{name}': kinds are loaded between steps; call load_kind(\"{name}\") in the scene script"
         )),
     })
+}
+
+/// Loads kind `name` with the constants `constants` names set (the runtime applies them to its
+/// text as it is built); a kind loaded already cannot take them any more.
+fn load_kind_setting(host: &Rc<Host>, name: &str, constants: &Map) -> Res<()> {
+    let rt = host.runtime()?;
+    // A kind given by path is named after its file.
+    let kind = if name.ends_with(".rhai") || name.contains('/') {
+        std::path::Path::new(name)
+            .file_stem()
+            .map_or_else(|| name.to_string(), |s| s.to_string_lossy().into_owned())
+    } else {
+        name.to_string()
+    };
+    let loaded = rt.kinds.borrow().contains_key(&kind)
+        || with_env!(host, env => Ok(env.kinds().id(&kind).is_ok()))?;
+    if loaded && !constants.is_empty() {
+        return fail_hint(
+            format!("load_kind(\"{name}\", ...): the kind '{kind}' is loaded already, with its constants as they were"),
+            "set its constants before it is first spawned or loaded: call load_kind with them first",
+        );
+    }
+    rt.kind_sets.borrow_mut().entry(kind).or_default().extend(
+        constants
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string())),
+    );
+    ensure_kind(host, name).map(drop)
 }
 
 fn config<V: Vector>(map: &Map) -> Res<(WorldConfig<V>, Option<u64>)> {
@@ -198,6 +226,10 @@ pub(super) fn register(api: &mut Api) {
     api.kind_func("load_kind", |h| {
         move |name: &str| -> Res<()> { ensure_kind(&h, name).map(drop) }
     });
+    // load_kind("boid", #{ SIGHT: 3 }): the kind with its constants set, as `--set boid.SIGHT=3`.
+    api.kind_func("load_kind", |h| {
+        move |name: &str, constants: Map| -> Res<()> { load_kind_setting(&h, name, &constants) }
+    });
 
     api.func("wall", |h| {
         move |_: &mut WorldRef, a: DVec3, b: DVec3| -> Res<CritterRef> {
@@ -297,9 +329,20 @@ pub(super) fn register(api: &mut Api) {
     api.kind_func("scatter", |h| {
         move |_: &mut WorldRef, kind: &str, count: INT, map: Map| -> Res<Array> {
             let kind = ensure_kind(&h, kind)?;
+            // `within` picks the region; the rest of the map is each spawn's.
+            let mut map = map;
+            let within = map.remove("within");
+            let asked = count.max(0) as usize;
             let mut out = Array::new();
-            for _ in 0..count.max(0) {
-                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, &kind, &map))?);
+            for placed in 0..asked {
+                let scatter = Scatter {
+                    kind: &kind,
+                    map: &map,
+                    within: within.as_ref(),
+                    placed,
+                    asked,
+                };
+                out.push(on_world!(h, "scatter", w => scatter_one(w, &h, &scatter))?);
             }
             Ok(out)
         }
@@ -390,13 +433,87 @@ fn spawn_at(
     Ok(out)
 }
 
-/// One critter at a random free place in the world box (seeded), clear of walls and critters.
-fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) -> Res<Dynamic> {
-    let spec = spec_from_map::<V>(kind, map)?;
+/// How many tries `scatter` makes for each critter before it gives up.
+const SCATTER_TRIES: usize = 1000;
+
+/// One critter of a `w.scatter(kind, n, #{ ... })`: the kind, its spawn map, the region
+/// (`within`, else the whole box), and how many of the `asked` are placed already.
+struct Scatter<'a> {
+    kind: &'a str,
+    map: &'a Map,
+    within: Option<&'a Dynamic>,
+    placed: usize,
+    asked: usize,
+}
+
+/// The region `within: [vec(x0, y0), vec(x1, y1)]` names (two opposite corners), checked to lie
+/// in the world box `min..max` and to hold a critter of radius `r`.
+fn scatter_region<V: Vector>(within: &Dynamic, min: V, max: V, r: f64) -> Res<(V, V)> {
+    let shape = "within is a region, two opposite corners: #{ within: [vec(x0, y0), vec(x1, y1)] }";
+    let corners = within
+        .clone()
+        .try_cast::<Array>()
+        .filter(|a| a.len() == 2)
+        .and_then(|a| {
+            let a0 = a[0].clone().try_cast::<DVec3>()?;
+            let a1 = a[1].clone().try_cast::<DVec3>()?;
+            Some((from_svec::<V>(a0), from_svec::<V>(a1)))
+        });
+    let Some((a, b)) = corners else {
+        return fail(format!("{shape}, not {}", super::values::show(within)));
+    };
+    let (mut lo, mut hi) = (a, b);
+    for axis in 0..V::DIM {
+        let (x, y) = (a.get(axis), b.get(axis));
+        lo.set(axis, x.min(y));
+        hi.set(axis, x.max(y));
+    }
+    let region = || format!("{} to {}", fmt_vec(lo), fmt_vec(hi));
+    if !(lo.all_finite() && hi.all_finite()) {
+        return fail(format!(
+            "within {}: every coordinate must be a finite number",
+            region()
+        ));
+    }
+    for axis in 0..V::DIM {
+        if lo.get(axis) < min.get(axis) || hi.get(axis) > max.get(axis) {
+            return fail_hint(
+                format!(
+                    "within {}: the region reaches out of the world box {} to {}",
+                    region(),
+                    fmt_vec(min),
+                    fmt_vec(max)
+                ),
+                "give corners inside the box",
+            );
+        }
+        if hi.get(axis) - lo.get(axis) < 2.0 * r {
+            return fail_hint(
+                format!(
+                    "within {}: the region is narrower than the critters' diameter {} along {}",
+                    region(),
+                    2.0 * r,
+                    ["x", "y", "z"][axis]
+                ),
+                "make the region larger or the radius smaller",
+            );
+        }
+    }
+    Ok((lo, hi))
+}
+
+/// One critter at a random free place (seeded) in the region `within` names or else the world
+/// box, clear of walls and critters.
+fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, s: &Scatter) -> Res<Dynamic> {
+    let kind = s.kind;
+    let spec = spec_from_map::<V>(kind, s.map)?;
     let kid = w.kinds().id(kind).map_err(lib_err)?;
     let r = spec.radius.unwrap_or(w.kinds().get(kid).defaults.radius);
-    let (min, max) = (w.topology().min, w.topology().max);
-    for _ in 0..1000 {
+    let (min, max) = match s.within {
+        Some(within) => scatter_region(within, w.topology().min, w.topology().max, r)?,
+        None => (w.topology().min, w.topology().max),
+    };
+    for _ in 0..SCATTER_TRIES {
         let mut p = V::zero();
         for axis in 0..V::DIM {
             p.set(axis, w.rng().uniform(min.get(axis) + r, max.get(axis) - r));
@@ -413,14 +530,23 @@ fn scatter_one<V: Vector>(w: &mut World<V>, host: &Host, kind: &str, map: &Map) 
         });
         let free = clear_of_walls && !w.overlaps_critter(p, r);
         if free {
-            let mut m = map.clone();
+            let mut m = s.map.clone();
             m.insert("pos".into(), Dynamic::from(to_svec(p)));
             let spec = spec_from_map::<V>(kind, &m)?;
             let id = w.spawn(spec).map_err(|e| host.carry(e))?;
             return Ok(Dynamic::from(CritterRef(id)));
         }
     }
-    fail(format!(
-        "no free place for another {kind} after 1000 tries: the world is too full"
-    ))
+    let place = match s.within {
+        Some(_) => format!("the region {} to {}", fmt_vec(min), fmt_vec(max)),
+        None => "the world".to_string(),
+    };
+    fail_hint(
+        format!(
+            "no free place for another {kind} of radius {r} after {SCATTER_TRIES} tries: {} of \
+             the {} asked for are placed, and {place} is too full",
+            s.placed, s.asked
+        ),
+        "ask for fewer, give them a smaller radius, or give them more room",
+    )
 }

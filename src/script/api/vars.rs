@@ -4,17 +4,47 @@
 //! returned by a getter would be a copy). The values are the critter properties' (numbers,
 //! bools, strings, `Vec`s, critters, arrays and maps of those); the map is part of the state hash
 //! and of the recording.
+//!
+//! A compound assignment to a var nobody set (`w.vars["s"] -= 1`) must fail as a read does.
+//! rhai runs `x[i] op= v` on a type with an indexer as a read through the getter, then a write
+//! through the setter, and when the getter fails it drops that error and writes `v` as it is
+//! (so `-= 1` made +1). So the getter marks the handle it was called on with the name it missed
+//! and where it was called; the setter, called right after on the same handle at the same place,
+//! finds the mark and fails. A plain `w.vars["s"] = v` calls no getter, and a failed read
+//! elsewhere left its mark at another place, so only the compound assignment is refused.
 
 use super::registry::Api;
 use super::values::{from_prop, to_prop};
 use super::world::WorldRef;
 use super::{fail, fail_hint, Res};
 use crate::script::host::{with_env, Host};
-use rhai::{Array, Dynamic, Map, INT};
+use rhai::{Array, Dynamic, Map, NativeCallContext, Position, INT};
 
 /// A handle to the world's vars, as scripts see it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct VarsRef;
+#[derive(Clone, Debug, Default)]
+pub(crate) struct VarsRef {
+    /// The last name the getter did not find through this handle, and where (see the module
+    /// docs).
+    missed: Option<Missed>,
+}
+
+/// A read of a var that does not exist: the name, and the call's file and position.
+#[derive(Clone, Debug, PartialEq)]
+struct Missed {
+    name: String,
+    source: Option<String>,
+    pos: Position,
+}
+
+impl Missed {
+    fn at(ctx: &NativeCallContext, name: &str) -> Missed {
+        Missed {
+            name: name.to_string(),
+            source: ctx.call_source().map(str::to_string),
+            pos: ctx.call_position(),
+        }
+    }
+}
 
 /// The error where the vars are out of reach.
 fn out_of_reach<T>() -> Res<T> {
@@ -24,17 +54,24 @@ fn out_of_reach<T>() -> Res<T> {
     )
 }
 
-fn get(host: &Host, name: &str) -> Res<Dynamic> {
+/// The error of a var never set, for a read and for a compound assignment alike.
+fn no_var<T>(name: &str) -> Res<T> {
+    fail_hint(
+        format!("world().vars has no '{name}'"),
+        format!("give it a value first, e.g. in the scene: w.vars.{name} = 0; or test with w.vars.has(\"{name}\")"),
+    )
+}
+
+/// The var `name`, or `None` when it was never set.
+fn lookup(host: &Host, name: &str) -> Res<Option<Dynamic>> {
     with_env!(host, env => match env.vars() {
-        Some(vars) => match vars.get(name) {
-            Some(v) => Ok(from_prop(v)),
-            None => fail_hint(
-                format!("world().vars has no '{name}'"),
-                format!("give it a value first, e.g. in the scene: w.vars.{name} = 0; or test with w.vars.has(\"{name}\")"),
-            ),
-        },
+        Some(vars) => Ok(vars.get(name).map(from_prop)),
         None => out_of_reach(),
     })
+}
+
+fn get(host: &Host, name: &str) -> Res<Dynamic> {
+    lookup(host, name)?.map_or_else(|| no_var(name), Ok)
 }
 
 fn set(host: &Host, name: &str, value: &Dynamic) -> Res<()> {
@@ -50,11 +87,33 @@ fn set(host: &Host, name: &str, value: &Dynamic) -> Res<()> {
 
 pub(super) fn register(api: &mut Api) {
     api.engine.register_type_with_name::<VarsRef>("Vars");
-    api.engine.register_get("vars", |_: &mut WorldRef| VarsRef);
+    api.engine
+        .register_get("vars", |_: &mut WorldRef| VarsRef::default());
 
     // w.vars["name"], and w.vars.name through rhai's fallback from properties to the indexer.
-    api.index_get(|h| move |_: &mut VarsRef, name: &str| get(&h, name));
-    api.index_set(|h| move |_: &mut VarsRef, name: &str, value: Dynamic| set(&h, name, &value));
+    // The getter marks a miss and the setter refuses the write it belongs to (module docs).
+    api.index_get(|h| {
+        move |ctx: NativeCallContext, v: &mut VarsRef, name: &str| -> Res<Dynamic> {
+            match lookup(&h, name)? {
+                Some(value) => {
+                    v.missed = None;
+                    Ok(value)
+                }
+                None => {
+                    v.missed = Some(Missed::at(&ctx, name));
+                    no_var(name)
+                }
+            }
+        }
+    });
+    api.index_set(|h| {
+        move |ctx: NativeCallContext, v: &mut VarsRef, name: &str, value: Dynamic| -> Res<()> {
+            if v.missed.take().is_some_and(|m| m == Missed::at(&ctx, name)) {
+                return no_var(name);
+            }
+            set(&h, name, &value)
+        }
+    });
     // rhai gives every value a `tag`; here, as for critters, it is a var like any other.
     api.get("tag", |h| move |_: &mut VarsRef| get(&h, "tag"));
     api.set("tag", |h| {
