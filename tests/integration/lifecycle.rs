@@ -470,8 +470,11 @@ impl KindHooks<DVec2> for Slayer {
     }
 }
 
-/// Keeps every damage it takes: (me, amount, source).
-struct Sore(Rc<std::cell::RefCell<Vec<(CritterId, f64, Option<CritterId>)>>>);
+/// A damage as `on_damage` hears of it: (me, amount, source).
+type Heard = (CritterId, f64, Option<CritterId>);
+
+/// Keeps every damage it takes.
+struct Sore(Rc<std::cell::RefCell<Vec<Heard>>>);
 
 impl KindHooks<DVec2> for Sore {
     fn has_on_damage(&self) -> bool {

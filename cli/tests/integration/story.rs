@@ -96,6 +96,10 @@ fn events<'a>(story: &'a Value, event: &str) -> Vec<&'a Value> {
         .collect()
 }
 
+/// An event as the lifecycle channel has it: the critter, the amount or cause, the critter and
+/// hook that caused it, the critter's kind.
+type Event<'a, T> = (u64, T, Option<u64>, Option<&'a str>, &'a str);
+
 /// The recording's lifecycle messages, read with the library.
 fn lifecycle(file: &Path) -> Vec<LifecycleMsg> {
     Recording::open(file).expect("readable").lifecycle
@@ -148,7 +152,7 @@ fn the_lifecycle_channel_names_who_caused_each_spawn_damage_and_death() {
         "the gun's update spawned both shots, in steps 1 and 41"
     );
     let shots: Vec<u64> = life.iter().flat_map(|l| l.spawn.clone()).collect();
-    let damages: Vec<(u64, f64, Option<u64>, Option<&str>, &str)> = life
+    let damages: Vec<Event<f64>> = life
         .iter()
         .flat_map(|l| {
             (0..l.damage_id.len()).map(move |i| {
@@ -169,7 +173,7 @@ fn the_lifecycle_channel_names_who_caused_each_spawn_damage_and_death() {
             (target, 1.0, Some(shots[1]), Some("collide"), "target")
         ]
     );
-    let deaths: Vec<(u64, &str, Option<u64>, Option<&str>, &str)> = life
+    let deaths: Vec<Event<&str>> = life
         .iter()
         .flat_map(|l| {
             (0..l.die.len()).map(move |i| {
