@@ -4,7 +4,7 @@
 //! implementation of [`KindHooks`]. The native behaviour is the trait's default methods, so
 //! `impl KindHooks for ()` is the plain ball; scripted kinds implement the same trait.
 
-use crate::critter::{Critter, CP_CRITTER, CP_WALL};
+use crate::critter::{Critter, CritterId, CP_CRITTER, CP_WALL};
 use crate::error::Error;
 pub use crate::ids::KindId;
 use crate::step::access::{CollideCtx, HookContact, UpdateCtx};
@@ -146,6 +146,23 @@ pub trait KindHooks<V: Vector> {
     fn on_death(&self, _ctx: &mut UpdateCtx<'_, V>) -> Result<(), Error> {
         Ok(())
     }
+
+    /// Whether [`KindHooks::on_damage`] does anything; without any, damage queues nothing.
+    fn has_on_damage(&self) -> bool {
+        false
+    }
+
+    /// Called once per damage `ctx.me` took, `amount` of it, from `source`: the critter whose
+    /// hook did it, `None` for the scene or a test between steps. Inside a step it runs in the
+    /// damage stage (`step::damage`), between steps at once.
+    fn on_damage(
+        &self,
+        _ctx: &mut UpdateCtx<'_, V>,
+        _amount: f64,
+        _source: Option<CritterId>,
+    ) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 /// The native behaviour: plain balls and walls.
@@ -209,6 +226,7 @@ pub struct Kind<V: Vector> {
     pub(crate) has_collide: bool,
     pub(crate) has_touch_hooks: bool,
     pub(crate) has_on_death: bool,
+    pub(crate) has_on_damage: bool,
     pub(crate) rule_depends_on_state: bool,
 }
 
@@ -228,6 +246,7 @@ impl<V: Vector> Kind<V> {
             has_collide: hooks.has_collide(),
             has_touch_hooks: hooks.has_touch_hooks(),
             has_on_death: hooks.has_on_death(),
+            has_on_damage: hooks.has_on_damage(),
             rule_depends_on_state: hooks.rule_depends_on_state(),
             defaults,
             hooks,
@@ -243,6 +262,8 @@ pub struct KindSet<V: Vector> {
     tracks_touch: bool,
     /// Some kind has an `on_death` hook.
     has_on_death: bool,
+    /// Some kind has an `on_damage` hook.
+    has_on_damage: bool,
 }
 
 /// The kind id of `wall` in every world.
@@ -262,6 +283,7 @@ impl<V: Vector> KindSet<V> {
             by_name: BTreeMap::new(),
             tracks_touch: false,
             has_on_death: false,
+            has_on_damage: false,
         };
         set.insert("ball", None, KindDefaults::default(), Rc::new(()));
         let wall = KindDefaults {
@@ -284,6 +306,7 @@ impl<V: Vector> KindSet<V> {
         self.by_name.insert(name.to_string(), id);
         self.tracks_touch |= hooks.tracks_touch();
         self.has_on_death |= hooks.has_on_death();
+        self.has_on_damage |= hooks.has_on_damage();
         self.kinds
             .push(Kind::new(name.to_string(), parent, defaults, hooks));
         id
@@ -343,6 +366,7 @@ impl<V: Vector> KindSet<V> {
         self.kinds[id.0 as usize] = Kind::new(name, parent, defaults, hooks);
         self.tracks_touch = self.kinds.iter().any(|k| k.hooks.tracks_touch());
         self.has_on_death = self.kinds.iter().any(|k| k.has_on_death);
+        self.has_on_damage = self.kinds.iter().any(|k| k.has_on_damage);
         Ok(())
     }
 
@@ -387,6 +411,11 @@ impl<V: Vector> KindSet<V> {
     /// True when some kind has an `on_death` hook.
     pub fn has_on_death(&self) -> bool {
         self.has_on_death
+    }
+
+    /// True when some kind has an `on_damage` hook.
+    pub fn has_on_damage(&self) -> bool {
+        self.has_on_damage
     }
 
     /// Number of kinds.

@@ -78,7 +78,7 @@ pub use parallel::PARALLEL_MIN;
 pub use rng::Rng;
 pub use rules::RuleCache;
 pub use step::access::{Access, CollideCtx, HookContact, UpdateCtx};
-pub use step::events::{CollisionEvent, StepEvents};
+pub use step::events::{CollisionEvent, DamageInfo, DeathCause, DeathInfo, HookAt, StepEvents};
 #[doc(hidden)]
 pub use vector::Align64;
 pub use vector::Vector;

@@ -4,8 +4,10 @@
 use super::foxglove::{kind_color, Rgba};
 use super::schema::{
     id_key, CollisionsMsg, Float, Floats, LifecycleMsg, LogMsg, StateMsg, TotalsMsg, WallMsg,
+    CAUSE_DAMAGE, CAUSE_DIE, CAUSE_REMOVED,
 };
 use crate::scenes::AnyWorld;
+use crate::step::events::{DeathCause, HookAt};
 use crate::vector::Vector;
 use crate::world::World;
 use std::collections::BTreeMap;
@@ -189,7 +191,32 @@ pub fn events<V: Vector>(
         m
     });
     let any_life = !(ev.spawns.is_empty() && ev.deaths.is_empty() && ev.damages.is_empty());
-    let lifecycle = any_life.then(|| LifecycleMsg {
+    let lifecycle = any_life.then(|| lifecycle_msg(world, step, time));
+    let log = (!ev.log.is_empty()).then(|| LogMsg {
+        step,
+        time,
+        lines: ev.log.clone(),
+    });
+    (collisions, lifecycle, log)
+}
+
+/// The lifecycle message of the last step: spawns, deaths and damage, and who caused each.
+fn lifecycle_msg<V: Vector>(world: &World<V>, step: u64, time: Float) -> LifecycleMsg {
+    let ev = world.events();
+    let kinds = world.kinds();
+    let by = |h: &Option<HookAt>| h.map(|h| id_key(h.critter));
+    let hook = |h: &Option<HookAt>| h.map(|h| h.hook.to_string());
+    let (die_cause, die_at): (Vec<String>, Vec<Option<HookAt>>) = ev
+        .death_info
+        .iter()
+        .map(|d| match d.cause {
+            DeathCause::Die(at) => (CAUSE_DIE.to_string(), at),
+            DeathCause::Damage(at) => (CAUSE_DAMAGE.to_string(), at),
+            DeathCause::Removed => (CAUSE_REMOVED.to_string(), None),
+        })
+        .unzip();
+    let sources: Vec<Option<HookAt>> = ev.damage_info.iter().map(|d| d.source).collect();
+    LifecycleMsg {
         step,
         time,
         spawn: ev.spawns.iter().map(|&id| id_key(id)).collect(),
@@ -199,20 +226,31 @@ pub fn events<V: Vector>(
             .map(|&id| {
                 world
                     .get(id)
-                    .map_or("?", |c| world.kinds().name(c.kind()))
+                    .map_or("?", |c| kinds.name(c.kind()))
                     .to_string()
             })
             .collect(),
+        spawn_by: ev.spawn_by.iter().map(by).collect(),
+        spawn_hook: ev.spawn_by.iter().map(hook).collect(),
         die: ev.deaths.iter().map(|&id| id_key(id)).collect(),
+        die_kind: ev
+            .death_info
+            .iter()
+            .map(|d| kinds.name(d.kind).to_string())
+            .collect(),
+        die_cause,
+        die_by: die_at.iter().map(by).collect(),
+        die_hook: die_at.iter().map(hook).collect(),
         damage_id: ev.damages.iter().map(|&(id, _)| id_key(id)).collect(),
         damage: Floats(ev.damages.iter().map(|&(_, d)| d).collect()),
-    });
-    let log = (!ev.log.is_empty()).then(|| LogMsg {
-        step,
-        time,
-        lines: ev.log.clone(),
-    });
-    (collisions, lifecycle, log)
+        damage_kind: ev
+            .damage_info
+            .iter()
+            .map(|d| kinds.name(d.kind).to_string())
+            .collect(),
+        damage_source: sources.iter().map(by).collect(),
+        damage_hook: sources.iter().map(hook).collect(),
+    }
 }
 
 /// Captures a step of `world`: always hash, totals and events; the full state when `full`; the

@@ -57,6 +57,16 @@ pub enum RecordingError {
         /// The hash as written.
         hash: String,
     },
+    /// `inspect --critter ID` named a critter the recording does not hold.
+    #[error("critter {critter} is not in {path}: no full state, collision or lifecycle event names it ({hint}); give an id as `inspect` and `replay --step` print them")]
+    NoSuchCritter {
+        /// The file.
+        path: PathBuf,
+        /// The critter asked for, as ids print.
+        critter: String,
+        /// The ids the file has near it.
+        hint: String,
+    },
     /// A recorded full state whose columns do not fit together.
     #[error("the state of step {step}: {reason}")]
     BadState {

@@ -133,6 +133,80 @@ fn state_rows(csv: &mut Csv, s: &StateMsg) -> std::io::Result<()> {
     Ok(())
 }
 
+/// The kinds of the critters a reader has seen (in spawns and full states), by id.
+#[derive(Default)]
+struct KindsSeen(std::collections::BTreeMap<u64, String>);
+
+impl KindsSeen {
+    fn saw(&mut self, ids: &[u64], kind: &[u32], names: &[String]) {
+        for (&id, &k) in ids.iter().zip(kind) {
+            if let Some(name) = names.get(k as usize) {
+                self.0.entry(id).or_insert_with(|| name.clone());
+            }
+        }
+    }
+    fn spawned(&mut self, l: &LifecycleMsg) {
+        for (&id, kind) in l.spawn.iter().zip(&l.spawn_kind) {
+            self.0.insert(id, kind.clone());
+        }
+    }
+    /// The kind of `id`: as the event names it, else as seen before.
+    fn of<'a>(&'a self, named: Option<&'a String>, id: u64) -> &'a str {
+        named.or_else(|| self.0.get(&id)).map_or("", String::as_str)
+    }
+}
+
+/// The ids and kinds of a full state, all a reader needs of it to know the kinds.
+#[derive(serde::Deserialize)]
+struct KindColumns {
+    id: Vec<u64>,
+    kind: Vec<u32>,
+    kinds: Vec<String>,
+}
+
+/// Writes the `by` cell: the critter, or nothing for the scene.
+fn by_cell(csv: &mut Csv, by: Option<&Option<u64>>) {
+    match by.copied().flatten() {
+        Some(id) => csv.id(id),
+        None => csv.s(""),
+    };
+}
+
+/// A hook's name, or nothing for the scene.
+fn hook_cell(v: Option<&Option<String>>) -> &str {
+    v.and_then(Option::as_deref).unwrap_or("")
+}
+
+/// The rows of a lifecycle message: spawns, deaths, damage, each with its kind and cause.
+fn lifecycle_rows(csv: &mut Csv, l: &LifecycleMsg, kinds: &KindsSeen) -> std::io::Result<()> {
+    for (i, &id) in l.spawn.iter().enumerate() {
+        let kind = kinds.of(l.spawn_kind.get(i), id);
+        csv.u(l.step).f(l.time.0).s("spawn").id(id).s(kind).s("");
+        by_cell(csv, l.spawn_by.get(i));
+        csv.s(hook_cell(l.spawn_hook.get(i))).s("").end()?;
+    }
+    for (i, &id) in l.die.iter().enumerate() {
+        let kind = kinds.of(l.die_kind.get(i), id);
+        csv.u(l.step).f(l.time.0).s("die").id(id).s(kind).s("");
+        by_cell(csv, l.die_by.get(i));
+        let cause = l.die_cause.get(i).map_or("", String::as_str);
+        csv.s(hook_cell(l.die_hook.get(i))).s(cause).end()?;
+    }
+    for (i, &id) in l.damage_id.iter().enumerate() {
+        let amount = l.damage.0.get(i).copied().unwrap_or(f64::NAN);
+        let kind = kinds.of(l.damage_kind.get(i), id);
+        csv.u(l.step)
+            .f(l.time.0)
+            .s("damage")
+            .id(id)
+            .s(kind)
+            .f(amount);
+        by_cell(csv, l.damage_source.get(i));
+        csv.s(hook_cell(l.damage_hook.get(i))).s("").end()?;
+    }
+    Ok(())
+}
+
 /// Writes `states.csv`, `steps.csv`, `collisions.csv`, `lifecycle.csv` and `log.csv` into `dir`.
 /// With `every_step`, states.csv has every step, re-simulated between the keyframes (and
 /// checked against every recorded hash); otherwise the recorded full states.
@@ -166,8 +240,13 @@ pub fn export_csv(
     let mut lifecycle = Csv::create(
         dir,
         "lifecycle.csv",
-        &["step", "time", "event", "id", "kind", "amount"],
+        &[
+            "step", "time", "event", "id", "kind", "amount", "by", "hook", "cause",
+        ],
     )?;
+    // A format 1 file names no kinds in its die and damage events: they are taken from the
+    // spawns and full states read before them.
+    let mut kinds = KindsSeen::default();
     let mut log = Csv::create(dir, "log.csv", &["step", "time", "line"])?;
     let mut out = Exported::default();
     let mut hash: Option<HashMsg> = None;
@@ -178,8 +257,13 @@ pub fn export_csv(
         match topic {
             schema::STATE if !every_step => {
                 let s = decode_state(data)?;
+                kinds.saw(&s.id, &s.kind, &s.kinds);
                 state_rows(&mut states, &s)?;
                 out.states += 1;
+            }
+            schema::STATE => {
+                let s: KindColumns = decode(topic, data)?;
+                kinds.saw(&s.id, &s.kind, &s.kinds);
             }
             schema::HASH => hash = Some(decode(topic, data)?),
             schema::TOTALS => {
@@ -222,26 +306,8 @@ pub fn export_csv(
             }
             schema::LIFECYCLE => {
                 let l: LifecycleMsg = decode(topic, data)?;
-                for (i, &id) in l.spawn.iter().enumerate() {
-                    let kind = l.spawn_kind.get(i).map_or("", String::as_str);
-                    lifecycle
-                        .u(l.step)
-                        .f(l.time.0)
-                        .s("spawn")
-                        .id(id)
-                        .s(kind)
-                        .s("");
-                    lifecycle.end()?;
-                }
-                for &id in &l.die {
-                    lifecycle.u(l.step).f(l.time.0).s("die").id(id).s("").s("");
-                    lifecycle.end()?;
-                }
-                for (i, &id) in l.damage_id.iter().enumerate() {
-                    let amount = l.damage.0.get(i).copied().unwrap_or(f64::NAN);
-                    lifecycle.u(l.step).f(l.time.0).s("damage").id(id).s("");
-                    lifecycle.f(amount).end()?;
-                }
+                kinds.spawned(&l);
+                lifecycle_rows(&mut lifecycle, &l, &kinds)?;
             }
             schema::LOG => {
                 let g: LogMsg = decode(topic, data)?;

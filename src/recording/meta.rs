@@ -4,7 +4,7 @@
 //! in their shortest round-trip form so they read back bit for bit.
 
 use super::keyframes::default_record_every;
-use super::schema::{FORMAT, STATE_HASH};
+use super::schema::{FORMAT, FORMATS_READ, STATE_HASH};
 use crate::profile::ProfileRow;
 use crate::scenes::Scene;
 use crate::script::Limits;
@@ -281,9 +281,10 @@ impl RunMeta {
         }
         let opt = |k: &str| m.get(k).map(String::as_str);
         let format = get("format")?;
-        if format != FORMAT {
+        if !FORMATS_READ.contains(&format) {
             return Err(format!(
-                "recording format '{format}' is not '{FORMAT}', the one this critterbox reads"
+                "recording format '{format}' is not one this critterbox reads ({}): it was made by another critterbox; read it with that one, or record the run again",
+                FORMATS_READ.join(", ")
             ));
         }
         let source = match get("scene_source")? {

@@ -30,6 +30,7 @@ pub mod recover;
 pub mod replay;
 pub mod scan;
 pub mod schema;
+pub mod story;
 pub mod verify;
 pub mod writer;
 

@@ -330,6 +330,16 @@ impl Recording {
         Ok(())
     }
 
+    /// The recording format's version: 2 for files this critterbox writes, 1 for older ones
+    /// (whose lifecycle events name no causes).
+    pub fn format_version(&self) -> u32 {
+        self.meta_map
+            .get("format")
+            .and_then(|f| f.rsplit('/').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1)
+    }
+
     /// True when part of the file could not be read (damaged or cut off), or steps are missing
     /// from it (a copy `recover` made of a damaged file).
     pub fn is_damaged(&self) -> bool {

@@ -39,8 +39,12 @@ pub const META: &str = "critterbox";
 pub const END: &str = "critterbox.end";
 /// Name of the metadata record `critterbox recover` adds.
 pub const RECOVERED: &str = "critterbox.recovered";
-/// Value of the `format` metadata key.
-pub const FORMAT: &str = "critterbox-recording/1";
+/// Value of the `format` metadata key. Format 2 added the causes of spawns, deaths and damage
+/// to the lifecycle channel (who, in which hook, and the kinds of the dead and the damaged).
+pub const FORMAT: &str = "critterbox-recording/2";
+/// The formats this critterbox reads: its own and format 1 (whose lifecycle messages name no
+/// causes).
+pub const FORMATS_READ: [&str; 2] = ["critterbox-recording/1", FORMAT];
 /// Value of the `state_hash` metadata key: which state hash the file's hashes were computed
 /// with. Files without the key used version 1; version 2 put each critter's sixteen words
 /// through one set of sixteen lanes; version 3 puts the first eight words through four
@@ -428,7 +432,9 @@ pub struct CollisionsMsg {
     pub impulse: Floats,
 }
 
-/// `/critterbox/lifecycle`: spawns, deaths and damage in a step.
+/// `/critterbox/lifecycle`: spawns, deaths and damage in a step, with who caused each.
+///
+/// The fields naming causes came with format 2; reading a format 1 file leaves them empty.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LifecycleMsg {
     /// Steps taken at the end of the step they happened in.
@@ -439,13 +445,91 @@ pub struct LifecycleMsg {
     pub spawn: Vec<u64>,
     /// Their kinds.
     pub spawn_kind: Vec<String>,
-    /// Critters that died (removed at the end of the step).
+    /// The critter whose hook spawned each (`None`: the scene).
+    #[serde(default)]
+    pub spawn_by: Vec<Option<u64>>,
+    /// That hook (`None`: the scene).
+    #[serde(default)]
+    pub spawn_hook: Vec<Option<String>>,
+    /// Critters that died (removed at the end of the step, or by the scene between steps).
     pub die: Vec<u64>,
+    /// Their kinds.
+    #[serde(default)]
+    pub die_kind: Vec<String>,
+    /// Why each died: [`CAUSE_DIE`], [`CAUSE_DAMAGE`] or [`CAUSE_REMOVED`].
+    #[serde(default)]
+    pub die_cause: Vec<String>,
+    /// The critter whose hook called `die()` or did the last damage (`None`: none, the scene).
+    #[serde(default)]
+    pub die_by: Vec<Option<u64>>,
+    /// That hook (`None`: no hook was running).
+    #[serde(default)]
+    pub die_hook: Vec<Option<String>>,
     /// Critters that took damage...
     pub damage_id: Vec<u64>,
     /// ...and how much.
     pub damage: Floats,
+    /// Their kinds.
+    #[serde(default)]
+    pub damage_kind: Vec<String>,
+    /// The critter whose hook did each damage (`None`: the scene or a test, between steps).
+    #[serde(default)]
+    pub damage_source: Vec<Option<u64>>,
+    /// That hook (`None`: the scene).
+    #[serde(default)]
+    pub damage_hook: Vec<Option<String>>,
 }
+
+impl LifecycleMsg {
+    /// What a format 1 file kept of these events: the spawns hooks made, the deaths at the end
+    /// of the step, the damage hooks dealt, with no causes; `None` when that is nothing.
+    pub fn format_1_view(&self) -> Option<LifecycleMsg> {
+        let spawns: Vec<usize> = (0..self.spawn.len())
+            .filter(|&i| self.spawn_by.get(i).is_none_or(Option::is_some))
+            .collect();
+        let deaths: Vec<usize> = (0..self.die.len())
+            .filter(|&i| match self.die_cause.get(i).map(String::as_str) {
+                Some(CAUSE_REMOVED) => false,
+                Some(CAUSE_DAMAGE) => self.die_by.get(i).is_some_and(Option::is_some),
+                _ => true,
+            })
+            .collect();
+        let damages: Vec<usize> = (0..self.damage_id.len())
+            .filter(|&i| self.damage_source.get(i).is_none_or(Option::is_some))
+            .collect();
+        if spawns.is_empty() && deaths.is_empty() && damages.is_empty() {
+            return None;
+        }
+        let pick = |v: &[u64], at: &[usize]| -> Vec<u64> {
+            at.iter().filter_map(|&i| v.get(i).copied()).collect()
+        };
+        Some(LifecycleMsg {
+            step: self.step,
+            time: self.time,
+            spawn: pick(&self.spawn, &spawns),
+            spawn_kind: spawns
+                .iter()
+                .filter_map(|&i| self.spawn_kind.get(i).cloned())
+                .collect(),
+            die: pick(&self.die, &deaths),
+            damage_id: pick(&self.damage_id, &damages),
+            damage: Floats(
+                damages
+                    .iter()
+                    .filter_map(|&i| self.damage.0.get(i).copied())
+                    .collect(),
+            ),
+            ..LifecycleMsg::default()
+        })
+    }
+}
+
+/// A `die_cause`: `die()` was called (in `die_hook` of `die_by`, or outside any hook).
+pub const CAUSE_DIE: &str = "die";
+/// A `die_cause`: health at or below 0 after damage (from `die_by`'s `die_hook`, or the scene).
+pub const CAUSE_DAMAGE: &str = "damage";
+/// A `die_cause`: removed by the scene or a test between steps.
+pub const CAUSE_REMOVED: &str = "removed";
 
 /// `/critterbox/log`: lines scripts logged in a step.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -648,24 +732,52 @@ pub fn channel_schemas() -> Vec<ChannelSchema> {
             "step", "time", "caller", "arg", "px", "py", "nx", "ny", "impulse",
         ],
     );
+    let maybe_ids = |description: &str| {
+        json!({ "type": "array", "items": { "type": ["integer", "null"], "minimum": 0 },
+                "description": format!("{description} (critter ids; null: the scene)") })
+    };
+    let maybe_hooks = |description: &str| {
+        json!({ "type": "array", "items": { "type": ["string", "null"] },
+                "description": format!("{description} (null: no hook, the scene)") })
+    };
+    let strings = |description: &str| json!({ "type": "array", "items": { "type": "string" }, "description": description });
     let lifecycle = object(
         "critterbox.Lifecycle",
-        "Spawns, deaths and damage in a step",
+        "Spawns, deaths and damage in a step, with who caused each; the arrays of a group (spawn, die, damage) have one item per event",
         step_props(json!({
             "spawn": ids_schema("critters spawned"),
-            "spawn_kind": { "type": "array", "items": { "type": "string" } },
+            "spawn_kind": strings("their kinds"),
+            "spawn_by": maybe_ids("the critter whose hook spawned each"),
+            "spawn_hook": maybe_hooks("that hook"),
             "die": ids_schema("critters that died"),
+            "die_kind": strings("their kinds"),
+            "die_cause": { "type": "array", "items": { "enum": [CAUSE_DIE, CAUSE_DAMAGE, CAUSE_REMOVED] },
+                           "description": "why: die() was called, health at or below 0 after damage, or removed by the scene between steps" },
+            "die_by": maybe_ids("the critter whose hook called die() or did the damage"),
+            "die_hook": maybe_hooks("that hook"),
             "damage_id": ids_schema("critters damaged"),
             "damage": floats_schema("damage taken, one per damage_id"),
+            "damage_kind": strings("the kinds of the critters damaged"),
+            "damage_source": maybe_ids("the critter whose hook did each damage"),
+            "damage_hook": maybe_hooks("that hook"),
         })),
         &[
             "step",
             "time",
             "spawn",
             "spawn_kind",
+            "spawn_by",
+            "spawn_hook",
             "die",
+            "die_kind",
+            "die_cause",
+            "die_by",
+            "die_hook",
             "damage_id",
             "damage",
+            "damage_kind",
+            "damage_source",
+            "damage_hook",
         ],
     );
     let log = object(

@@ -146,22 +146,21 @@ impl<V: Vector> Env<'_, V> {
         }
     }
 
-    pub(crate) fn damage(&mut self, id: CritterId, amount: f64) {
+    /// Pop's `damage`. Between steps the damaged critter's `on_damage` runs at once, with no
+    /// source, and an error from it comes back here; inside a step it runs in the step's
+    /// damage stage.
+    pub(crate) fn damage(&mut self, id: CritterId, amount: f64) -> Result<(), Error> {
         match self {
-            Env::World(w) => {
-                let dead = match w.get_mut(id) {
-                    Some(c) => {
-                        c.traits_mut().health -= amount;
-                        c.health() <= 0.0
-                    }
-                    None => false,
-                };
-                if dead {
-                    let _ = w.remove(id);
-                }
+            Env::World(w) => match w.damage(id, amount) {
+                // A handle to a critter that is gone damages nothing, as inside a step.
+                Err(Error::NoSuchCritter(_)) => Ok(()),
+                other => other,
+            },
+            Env::Hook(a) => {
+                a.damage(id, amount);
+                Ok(())
             }
-            Env::Hook(a) => a.damage(id, amount),
-            Env::Pair(_) => {}
+            Env::Pair(_) => Ok(()),
         }
     }
 

@@ -349,6 +349,31 @@ impl<V: Dim> KindHooks<V> for ScriptKind {
         }
         Ok(())
     }
+
+    fn has_on_damage(&self) -> bool {
+        self.def.hook("on_damage").is_some()
+    }
+
+    fn on_damage(
+        &self,
+        ctx: &mut UpdateCtx<'_, V>,
+        amount: f64,
+        source: Option<CritterId>,
+    ) -> Result<(), Error> {
+        if let Some(f) = self.def.hook("on_damage") {
+            let me = ctx.me().id();
+            let frame = self.frame("on_damage", f, me, source);
+            // The scene (or a test) is no critter: its damage comes from `()`.
+            let source = source.map_or(Dynamic::UNIT, |id| Dynamic::from(CritterRef(id)));
+            self.rt
+                .host
+                .enter_hook::<V, _>(&mut **ctx, || {
+                    self.call("on_damage", f, frame, (CritterRef(me), amount, source))
+                })
+                .map(drop)?;
+        }
+        Ok(())
+    }
 }
 
 /// What a `parent_*` call reaches: the hook of the nearest ancestor of the running level that

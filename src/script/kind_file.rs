@@ -5,9 +5,9 @@
 //! `extends "parent";` and `defaults(#{ radius: 0.1, ... });`, and define `const`s; it defines
 //! any of `init(me)`, `update(me, dt)`, `collides_with(me, other)`, `collide(me, other)` or
 //! `collide(me, other, contact)`, `touch_begin(me, other, contact)`, `touch_end(me, other)`,
-//! `on_death(me)`. Hooks it does not define are inherited from its parent kind, and from the
-//! engine beyond that; `me.parent_collide(other)` and its kin call the parent's (see
-//! [`super::kind_calls`]).
+//! `on_death(me)`, `on_damage(me, amount, source)`. Hooks it does not define are inherited
+//! from its parent kind, and from the engine beyond that; `me.parent_collide(other)` and its
+//! kin call the parent's (see [`super::kind_calls`]).
 
 use super::api::{error, fail, num_or, props_from_map, Res};
 use super::errors::{eval_error, fn_location};
@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::rc::{Rc, Weak};
 
 /// The hooks a kind may define, with the numbers of parameters each may take.
-pub(crate) const HOOKS: [(&str, &[usize]); 7] = [
+pub(crate) const HOOKS: [(&str, &[usize]); 8] = [
     ("init", &[1]),
     ("update", &[2]),
     ("collides_with", &[2]),
@@ -31,6 +31,7 @@ pub(crate) const HOOKS: [(&str, &[usize]); 7] = [
     ("touch_begin", &[3]),
     ("touch_end", &[2]),
     ("on_death", &[1]),
+    ("on_damage", &[3]),
 ];
 
 /// The parameters of hook `name`, as error messages name them.
@@ -40,6 +41,7 @@ fn hook_params(name: &str) -> &'static str {
         "update" => "me, dt",
         "collide" => "me, other or me, other, contact",
         "touch_begin" => "me, other, contact",
+        "on_damage" => "me, amount, source",
         _ => "me, other",
     }
 }

@@ -1,7 +1,7 @@
 //! What a kind's hooks see: the critters involved, the rest of the world read and write, and
 //! queues for structural changes (deaths, spawns) that take effect after the step.
 
-use super::events::CollisionEvent;
+use super::events::{CollisionEvent, DeathCause};
 use super::neighbours::Filter;
 use super::pending::{OnOverlap, PendingSpawn, SpawnOrigin};
 use super::state::State;
@@ -163,25 +163,35 @@ impl<V: Vector> Access<'_, V> {
     }
     /// Kills critter `id`: it takes no further collisions and is removed after the step.
     pub fn die(&mut self, id: CritterId) {
+        let cause = DeathCause::Die(self.state.hook);
+        self.die_because(id, cause);
+    }
+    /// Kills critter `id` for `cause` (kept for the step's events).
+    fn die_because(&mut self, id: CritterId, cause: DeathCause) {
         if let Some(c) = self.state.critters.get_mut(id) {
             if c.in_play() {
                 c.alive = false;
                 self.state.pending.deaths.push(id);
+                self.state.pending.death_causes.push(cause);
             }
         }
     }
-    /// Pop's `damage`: lowers health by `amount`; at or below zero the critter dies.
+    /// Pop's `damage`: lowers health by `amount`; at or below zero the critter dies. The damage
+    /// is an event naming the hook running (its source), and the critter's `on_damage` runs for
+    /// it later in the step (`step::damage`).
     pub fn damage(&mut self, id: CritterId, amount: f64) {
+        let by = self.state.hook;
         let dead = match self.state.critters.get_mut(id) {
             Some(c) if c.in_play() => {
                 c.traits_mut().health -= amount;
-                self.state.events.damages.push((id, amount));
-                c.health() <= 0.0
+                let (kind, dead) = (c.kind(), c.health() <= 0.0);
+                self.state.note_damage(id, kind, amount, by);
+                dead
             }
             _ => false,
         };
         if dead {
-            self.die(id);
+            self.die_because(id, DeathCause::Damage(by));
         }
     }
     /// Queues a spawn for the end of the step (checked then, like any spawn).
@@ -195,10 +205,12 @@ impl<V: Vector> Access<'_, V> {
         on_overlap: OnOverlap,
         origin: Option<Box<SpawnOrigin>>,
     ) {
+        let by = self.state.hook;
         self.state.pending.spawns.push(PendingSpawn {
             spec,
             on_overlap,
             origin,
+            by,
         });
     }
     /// Adds a line to the step's log.

@@ -5,7 +5,7 @@
 //! - [`state`]: what every stage and method reads and writes; [`span`]: the step's length,
 //!   made once per step and passed down;
 //! - the stages, each in a file named after it: `update`, `motion`, `pairs`, `response`,
-//!   `touch`, `lifecycle`;
+//!   `touch`, `damage`, `lifecycle`;
 //! - what the stages keep or queue: the neighbour grid (`neighbours`), the touching spells
 //!   (`spells`), spawn steps (`births`), the step's events (`events`), the hooks' queued
 //!   changes (`pending`) and how spawns are placed (`spawn`);
@@ -14,6 +14,7 @@
 
 pub(crate) mod access;
 pub(crate) mod births;
+pub(crate) mod damage;
 pub(crate) mod events;
 pub(crate) mod lifecycle;
 pub(crate) mod motion;

@@ -1,15 +1,31 @@
-//! What the hooks queue for the end of the step (deaths and spawns), how a spawn is placed when
-//! it overlaps something, and where a script asked for it.
+//! What the hooks queue for the end of the step (deaths, spawns, the damage whose `on_damage`
+//! is still to run), how a spawn is placed when it overlaps something, and where a script
+//! asked for it.
 
+use super::events::{DeathCause, HookAt};
 use crate::critter::{CritterId, CritterSpec};
 use crate::error::{Error, ScriptError};
 use crate::vector::Vector;
 
-/// Spawns waiting for the end of the step.
+/// Spawns and deaths waiting for the end of the step, and damage waiting for its `on_damage`.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Pending<V: Vector> {
     pub spawns: Vec<PendingSpawn<V>>,
     pub deaths: Vec<CritterId>,
+    /// Why each of `deaths` died, one per entry.
+    pub death_causes: Vec<DeathCause>,
+    /// Damage dealt whose `on_damage` has not run yet (only while some kind has the hook).
+    pub damages: Vec<PendingDamage>,
+}
+
+/// A damage whose `on_damage` hook is still to run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PendingDamage {
+    /// The critter damaged.
+    pub id: CritterId,
+    pub amount: f64,
+    /// The critter whose hook did it (`None`: the scene or a test).
+    pub source: Option<CritterId>,
 }
 
 /// A spawn queued by a hook: what to add, how to place it, and where it was asked for.
@@ -19,6 +35,8 @@ pub(crate) struct PendingSpawn<V: Vector> {
     pub on_overlap: OnOverlap,
     /// `None` for a spawn from Rust (`Access::spawn`).
     pub origin: Option<Box<SpawnOrigin>>,
+    /// The hook that asked for it (`None`: none was running).
+    pub by: Option<HookAt>,
 }
 
 /// Where a queued spawn was asked for, so that its failure at the end of the step names the

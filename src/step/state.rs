@@ -4,8 +4,8 @@
 
 use super::access::{Access, CollideCtx, UpdateCtx};
 use super::births::Births;
-use super::events::{CollisionEvent, StepEvents};
-use super::pending::Pending;
+use super::events::{CollisionEvent, DamageInfo, HookAt, StepEvents};
+use super::pending::{Pending, PendingDamage};
 use crate::border::Topology;
 use crate::critter::{CritterId, Props};
 use crate::critter_set::CritterSet;
@@ -45,6 +45,9 @@ pub(crate) struct State<V: Vector> {
     pub(crate) births: Births,
     /// The touching spells, kept when some kind tracks them.
     pub(crate) touch: super::spells::Spells<V>,
+    /// The kind's hook running now, if any: what a death, damage or spawn it asks for is
+    /// recorded as caused by.
+    pub(crate) hook: Option<HookAt>,
 }
 
 impl<V: Vector> State<V> {
@@ -70,13 +73,66 @@ impl<V: Vector> State<V> {
             .ok_or(Error::NoSuchCritter(id))?;
         let hooks = self.kinds.get(kind).hooks.clone();
         let me = self.critters.slot_of(id).ok_or(Error::NoSuchCritter(id))?;
+        let outer = self.enter_hook(id, "init");
         let mut ctx = UpdateCtx {
             access: self.access(),
             me,
         };
-        hooks
-            .init(&mut ctx)
-            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+        let done = hooks.init(&mut ctx);
+        self.hook = outer;
+        done.map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+    }
+
+    /// Notes that the hook `hook` of critter `critter` runs from now on; returns the one that
+    /// ran before, for the caller to put back when the hook returns.
+    pub(crate) fn enter_hook(&mut self, critter: CritterId, hook: &'static str) -> Option<HookAt> {
+        self.hook.replace(HookAt { critter, hook })
+    }
+
+    /// Notes a damage of `amount` to `id` (of kind `kind`) done by the hook `by`: the step's
+    /// event, and its `on_damage` to run when some kind has that hook.
+    pub(crate) fn note_damage(
+        &mut self,
+        id: CritterId,
+        kind: KindId,
+        amount: f64,
+        by: Option<HookAt>,
+    ) {
+        self.events.damages.push((id, amount));
+        self.events
+            .damage_info
+            .push(DamageInfo { kind, source: by });
+        if self.kinds.has_on_damage() {
+            self.pending.damages.push(PendingDamage {
+                id,
+                amount,
+                source: by.map(|h| h.critter),
+            });
+        }
+    }
+
+    /// Runs the `on_damage` hook of the critter `d` damaged, if it is still there and its kind
+    /// has one.
+    pub(crate) fn run_on_damage(&mut self, d: PendingDamage) -> Result<(), Error> {
+        let step = self.step_count;
+        let Some(me) = self.critters.slot_of(d.id) else {
+            return Ok(());
+        };
+        let Some(kind) = self.critters.slot(me).map(|c| c.kind()) else {
+            return Ok(());
+        };
+        if !self.kinds.get(kind).has_on_damage {
+            return Ok(());
+        }
+        let hooks = self.kinds.get(kind).hooks.clone();
+        let outer = self.enter_hook(d.id, "on_damage");
+        let mut ctx = UpdateCtx {
+            access: self.access(),
+            me,
+        };
+        let done = hooks.on_damage(&mut ctx, d.amount, d.source);
+        self.hook = outer;
+        done.map_err(|e| hook_error(e, &self.kinds, kind, d.id, step))
     }
 
     /// Runs critter `id`'s `on_death` hook, if its kind has one.
@@ -92,13 +148,14 @@ impl<V: Vector> State<V> {
             return Ok(());
         }
         let hooks = self.kinds.get(kind).hooks.clone();
+        let outer = self.enter_hook(id, "on_death");
         let mut ctx = UpdateCtx {
             access: self.access(),
             me,
         };
-        hooks
-            .on_death(&mut ctx)
-            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))
+        let done = hooks.on_death(&mut ctx);
+        self.hook = outer;
+        done.map_err(|e| hook_error(e, &self.kinds, kind, id, step))
     }
 
     /// In a periodic world, maps every live critter back into the box.
@@ -155,15 +212,16 @@ impl<V: Vector> State<V> {
         // The engine moves critters between collide calls: each call starts with no grid.
         self.neighbours.invalidate();
         let first = self.kinds.tracks_touch() && self.note_touch(caller, arg);
+        let outer = self.enter_hook(id, "collide");
         let mut ctx = CollideCtx {
             access: self.access(),
             me: caller,
             other: arg,
             first,
         };
-        let handled = hooks
-            .collide(&mut ctx)
-            .map_err(|e| hook_error(e, &self.kinds, kind, id, step))?;
+        let handled = hooks.collide(&mut ctx);
+        self.hook = outer;
+        let handled = handled.map_err(|e| hook_error(e, &self.kinds, kind, id, step))?;
         if handled && self.events.collisions.len() == events_before {
             // A hook that handled the pair its own way (a bullet's hit, a basket's catch) is a
             // collision too, with no impulse.

@@ -11,7 +11,8 @@
 //! The events of a step are sent by the touch stage, after the collision method and before the
 //! lifecycle: first every spell that ended (pairs in id order), then every spell that began
 //! (pairs in id order), each to the lower id's kind and then to the higher's, each from its own
-//! side. A critter that dies ends its spells in the lifecycle, before its `on_death`.
+//! side. A critter that dies ends its spells in the lifecycle, before its `on_death`; a spell
+//! that began in the step it died in gets its begin here first.
 
 use super::access::{CollideCtx, HookContact};
 use super::spells::{ordered, Pair};
@@ -69,17 +70,24 @@ impl<V: Vector> State<V> {
             };
             let hooks = self.kinds.get(kind_id).hooks.clone();
             let step = self.step_count;
+            let hook = if seen.is_some() {
+                "touch_begin"
+            } else {
+                "touch_end"
+            };
+            let outer = self.enter_hook(me, hook);
             let mut ctx = CollideCtx {
                 access: self.access(),
                 me: ms,
                 other: os,
                 first: seen.is_some(),
             };
-            match &seen {
+            let done = match &seen {
                 Some(seen) => hooks.touch_begin(&mut ctx, seen),
                 None => hooks.touch_end(&mut ctx),
-            }
-            .map_err(|e| hook_error(e, &self.kinds, kind_id, me, step))?;
+            };
+            self.hook = outer;
+            done.map_err(|e| hook_error(e, &self.kinds, kind_id, me, step))?;
         }
         Ok(())
     }
@@ -115,8 +123,7 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
     let mut now: Vec<_> = state.touch.now.drain().collect();
     now.sort_unstable_by_key(|(pair, _)| *pair);
     let open = std::mem::take(&mut state.touch.open);
-    let alive =
-        |state: &State<V>, id: CritterId| state.critters.get(id).is_some_and(|c| c.in_play());
+    let present = |state: &State<V>, id: CritterId| state.critters.get(id).is_some();
     let mut kept = Vec::with_capacity(open.len() + now.len());
     let mut ended = Vec::new();
     let mut begun = Vec::new();
@@ -151,7 +158,10 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>) -> Result<(), Error> {
             let Some((pair, contact)) = new.next() else {
                 break;
             };
-            if alive(state, pair.0) && alive(state, pair.1) {
+            if present(state, pair.0) && present(state, pair.1) {
+                // A spell whose critter died in this step (a shot dying in its own `collide`)
+                // begins all the same: the lifecycle ends it, so every spell has its begin and
+                // its end.
                 kept.push(pair);
                 if let Some(contact) = contact {
                     begun.push((pair, contact));

@@ -26,13 +26,14 @@ pub(crate) fn run<V: Vector>(state: &mut State<V>, span: Span) -> Result<(), Err
         }
         let (kind, id) = (c.kind(), c.id);
         let hooks = state.kinds.get(kind).hooks.clone();
+        let outer = state.enter_hook(id, "update");
         let mut ctx = UpdateCtx {
             access: state.access(),
             me: slot,
         };
-        hooks
-            .update(&mut ctx, dt)
-            .map_err(|e| hook_error(e, &state.kinds, kind, id, step))?;
+        let done = hooks.update(&mut ctx, dt);
+        state.hook = outer;
+        done.map_err(|e| hook_error(e, &state.kinds, kind, id, step))?;
     }
     Ok(())
 }

@@ -5,6 +5,8 @@ use super::World;
 use crate::critter::{Critter, CritterId, CritterSpec};
 use crate::error::Error;
 use crate::kind::{KindDefaults, KindHooks, KindId};
+use crate::step::damage;
+use crate::step::events::DeathCause;
 use crate::step::lifecycle;
 use crate::step::pending::OnOverlap;
 use crate::step::spawn::Placed;
@@ -13,13 +15,19 @@ use crate::wall::WallBox;
 use std::rc::Rc;
 
 impl<V: Vector> World<V> {
-    /// Spawns a critter now, placed under `on_overlap`.
+    /// Spawns a critter now, placed under `on_overlap` (a scene's or a test's spawn). After
+    /// step 0 the spawn is in the events of the last step, made by the scene; the scene as
+    /// built is the state at step 0.
     pub(crate) fn spawn_placed(
         &mut self,
         spec: CritterSpec<V>,
         on_overlap: OnOverlap,
     ) -> Result<Placed, Error> {
-        self.state.spawn_placed(spec, on_overlap)
+        let placed = self.state.spawn_placed(spec, on_overlap)?;
+        if let (Placed::Added(id), true) = (&placed, self.state.step_count > 0) {
+            self.state.events.spawned(*id, None);
+        }
+        Ok(placed)
     }
 
     /// Registers a kind (see [`crate::KindSet::register`]).
@@ -86,8 +94,18 @@ impl<V: Vector> World<V> {
 
     /// Removes critter `id` at once (outside a step). Returns it, or an error if it is not there.
     /// The critter's spells end and its `on_death` runs first, when some kind has those hooks;
-    /// what they queue (spawns, further deaths) takes effect before this returns.
+    /// what they queue (spawns, further deaths) takes effect before this returns. The death is
+    /// in the events of the last step, as removed by the scene.
     pub fn remove(&mut self, id: CritterId) -> Result<Critter<V>, Error> {
+        self.remove_because(id, DeathCause::Removed)
+    }
+
+    /// [`World::remove`], the death kept in the events for `cause`.
+    pub(crate) fn remove_because(
+        &mut self,
+        id: CritterId,
+        cause: DeathCause,
+    ) -> Result<Critter<V>, Error> {
         let hooked = self.state.kinds.tracks_touch() || self.state.kinds.has_on_death();
         let mut was_alive = true;
         if hooked {
@@ -97,14 +115,37 @@ impl<V: Vector> World<V> {
             };
             if was_alive {
                 lifecycle::before_removal(&mut self.state, &[id])?;
+                damage::run(&mut self.state)?;
             }
         }
         let mut c = self.remove_now(id)?;
+        self.state.events.died(id, c.kind(), cause);
         c.alive = was_alive;
         if hooked {
             self.lifecycle()?;
         }
         Ok(c)
+    }
+
+    /// Between steps, Pop's `damage` from the scene or a test: lowers the health of `id` by
+    /// `amount`, runs its `on_damage` at once (with no source), and removes it when its health
+    /// is then at or below zero. The damage is in the events of the last step. Nothing happens
+    /// to a critter that is gone or dead.
+    pub fn damage(&mut self, id: CritterId, amount: f64) -> Result<(), Error> {
+        let Some(c) = self.state.critters.get_mut(id) else {
+            return Err(Error::NoSuchCritter(id));
+        };
+        if !c.is_alive() {
+            return Ok(());
+        }
+        c.traits_mut().health -= amount;
+        let (kind, dead) = (c.kind(), c.health() <= 0.0);
+        self.state.note_damage(id, kind, amount, None);
+        damage::run(&mut self.state)?;
+        if dead && self.state.critters.get(id).is_some_and(|c| c.is_alive()) {
+            self.remove_because(id, DeathCause::Damage(None))?;
+        }
+        Ok(())
     }
 
     /// The lifecycle stage, its removals told to the method (what rested on them wakes).

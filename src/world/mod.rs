@@ -11,7 +11,9 @@
 //!    whose two critters are both still alive, or the contacts solved together); under the
 //!    event methods, a flight from event to event;
 //! 3. **touch**: the touching spells' begins and ends, when some kind has touch hooks;
-//! 4. **lifecycle**: the dead are removed, queued spawns are added.
+//! 4. **damage**: each damage of the step runs the damaged critter's `on_damage`, in id order;
+//! 5. **lifecycle**: the dead end their spells, run `on_death` and are removed, queued spawns
+//!    are added.
 //!
 //! Nothing in a step iterates a hash map or reads a clock to decide anything, and all randomness
 //! comes from the world's seeded generator, so the same world gives the same bits every run.
@@ -93,6 +95,7 @@ impl<V: Vector> World<V> {
                 neighbours: Default::default(),
                 births: Default::default(),
                 touch: Default::default(),
+                hook: None,
             },
             pairs: Pairs::new(config.broad_phase),
             methods: MethodState::new(config.method, config.sleep),

@@ -2,6 +2,7 @@
 
 use super::World;
 use crate::error::Error;
+use crate::step::damage;
 use crate::step::span::Span;
 use crate::step::stats::{timed, StepStats};
 use crate::step::touch;
@@ -10,7 +11,8 @@ use crate::vector::Vector;
 
 impl<V: Vector> World<V> {
     /// Advances the world by one time step: update hooks, the collision method's move, pairs
-    /// and response, the touch events (when some kind tracks touch), then deaths and spawns.
+    /// and response, the touch events (when some kind tracks touch), the damage hooks (when
+    /// some kind has `on_damage`), then deaths and spawns.
     ///
     /// An error from a hook or a bad queued spawn stops the step where it happened; the world is
     /// then part-way through that step.
@@ -38,6 +40,8 @@ impl<V: Vector> World<V> {
             // Timed with the lifecycle: both send what the step's contacts and deaths started.
             timed(&mut stats.lifecycle, || touch::run(&mut self.state))?;
         }
+        // The step's damage has been dealt: each damaged critter's `on_damage`, in id order.
+        timed(&mut stats.lifecycle, || damage::run(&mut self.state))?;
         timed(&mut stats.lifecycle, || self.lifecycle())?;
 
         self.finish_step(stats);

@@ -391,3 +391,167 @@ fn critter_killed_in_its_init_hook_takes_no_part_and_is_removed_after_the_next_s
     assert!(world.events().collisions.is_empty());
     assert_eq!(world.get(b).unwrap().vel, v);
 }
+
+#[test]
+fn damage_and_the_death_it_causes_name_the_hook_that_did_it() {
+    use critterbox::{DamageInfo, DeathCause, DeathInfo, HookAt};
+    let mut world = hitter_world(0.5);
+    let hitter = world
+        .spawn(CritterSpec::new("hitter", DVec2::new(5.0, 5.0)))
+        .unwrap();
+    let v = world
+        .spawn(CritterSpec::ball(DVec2::new(5.9, 5.0)).health(1.0))
+        .unwrap();
+    let ball = world.kinds().id("ball").unwrap();
+    let by = Some(HookAt {
+        critter: hitter,
+        hook: "collide",
+    });
+    world.step().unwrap();
+    assert_eq!(world.events().damages, vec![(v, 0.5)]);
+    assert_eq!(
+        world.events().damage_info,
+        vec![DamageInfo {
+            kind: ball,
+            source: by
+        }]
+    );
+    world.step().unwrap();
+    assert_eq!(world.events().deaths, vec![v]);
+    assert_eq!(
+        world.events().death_info,
+        vec![DeathInfo {
+            kind: ball,
+            cause: DeathCause::Damage(by)
+        }],
+        "health at 0 after the hitter's collide"
+    );
+}
+
+#[test]
+fn die_in_a_hook_and_removal_by_the_scene_are_deaths_with_their_causes() {
+    use critterbox::{DeathCause, HookAt};
+    let mut world = world2(10.0);
+    register(
+        &mut world,
+        "killer",
+        with_priority(CP_PLAYER),
+        Rc::new(Slayer),
+    );
+    let killer = world
+        .spawn(CritterSpec::new("killer", DVec2::new(5.0, 5.0)))
+        .unwrap();
+    let victim = world
+        .spawn(CritterSpec::ball(DVec2::new(5.9, 5.0)))
+        .unwrap();
+    world.step().unwrap();
+    assert_eq!(world.events().deaths, vec![victim]);
+    let cause = world.events().death_info[0].cause;
+    assert_eq!(
+        cause,
+        DeathCause::Die(Some(HookAt {
+            critter: killer,
+            hook: "collide"
+        }))
+    );
+    world.step().unwrap();
+    world.remove(killer).unwrap();
+    assert_eq!(world.events().deaths, vec![killer], "the scene's removal");
+    assert_eq!(world.events().death_info[0].cause, DeathCause::Removed);
+}
+
+/// Kills what it touches.
+struct Slayer;
+
+impl KindHooks<DVec2> for Slayer {
+    fn collide(&self, ctx: &mut CollideCtx<'_, DVec2>) -> Result<bool, Error> {
+        ctx.die_other();
+        Ok(true)
+    }
+}
+
+/// A damage as `on_damage` hears of it: (me, amount, source).
+type Heard = (CritterId, f64, Option<CritterId>);
+
+/// Keeps every damage it takes.
+struct Sore(Rc<std::cell::RefCell<Vec<Heard>>>);
+
+impl KindHooks<DVec2> for Sore {
+    fn has_on_damage(&self) -> bool {
+        true
+    }
+    fn on_damage(
+        &self,
+        ctx: &mut UpdateCtx<'_, DVec2>,
+        amount: f64,
+        source: Option<CritterId>,
+    ) -> Result<(), Error> {
+        let me = ctx.me().id();
+        self.0.borrow_mut().push((me, amount, source));
+        Ok(())
+    }
+}
+
+/// In its update, damages the critters of `targets` in the order given, by 1, 2, 3, ...
+struct Blaster(Vec<CritterId>);
+
+impl KindHooks<DVec2> for Blaster {
+    fn has_update(&self) -> bool {
+        true
+    }
+    fn update(&self, ctx: &mut UpdateCtx<'_, DVec2>, _dt: f64) -> Result<(), Error> {
+        for (i, &t) in self.0.iter().enumerate() {
+            ctx.damage(t, (i + 1) as f64);
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn on_damage_runs_once_per_damage_in_id_order_with_its_source() {
+    let mut world = world2(20.0);
+    let seen = Rc::new(std::cell::RefCell::new(Vec::new()));
+    register(
+        &mut world,
+        "sore",
+        KindDefaults {
+            health: 100.0,
+            ..KindDefaults::default()
+        },
+        Rc::new(Sore(seen.clone())),
+    );
+    let a = world
+        .spawn(CritterSpec::new("sore", DVec2::new(3.0, 3.0)))
+        .unwrap();
+    let b = world
+        .spawn(CritterSpec::new("sore", DVec2::new(6.0, 3.0)))
+        .unwrap();
+    register(
+        &mut world,
+        "blaster",
+        KindDefaults::default(),
+        Rc::new(Blaster(vec![b, a, b])),
+    );
+    let blaster = world
+        .spawn(CritterSpec::new("blaster", DVec2::new(15.0, 15.0)))
+        .unwrap();
+    world.step().unwrap();
+    assert_eq!(
+        *seen.borrow(),
+        vec![
+            (a, 2.0, Some(blaster)),
+            (b, 1.0, Some(blaster)),
+            (b, 3.0, Some(blaster))
+        ],
+        "a's damage first (lower id), then b's two in the order dealt"
+    );
+    // Between steps, from the scene: at once, with no source; the killing damage too.
+    seen.borrow_mut().clear();
+    world.damage(a, 98.0).unwrap();
+    assert_eq!(*seen.borrow(), vec![(a, 98.0, None)]);
+    assert!(world.get(a).is_none(), "health at 0: removed");
+    assert_eq!(
+        world.events().death_info.last().map(|d| d.cause),
+        Some(critterbox::DeathCause::Damage(None))
+    );
+}

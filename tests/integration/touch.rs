@@ -134,3 +134,55 @@ fn kinds_without_touch_hooks_keep_no_spells() {
     assert!(!w.kinds().tracks_touch());
     assert!(!w.kinds().has_on_death());
 }
+
+/// A watcher that, as the caller, dies in its own `collide`: on the first step of its spell.
+struct Shot(Rc<RefCell<Seen>>);
+
+impl<V: Vector> KindHooks<V> for Shot {
+    fn tracks_touch(&self) -> bool {
+        true
+    }
+    fn collide(&self, ctx: &mut CollideCtx<'_, V>) -> Result<bool, Error> {
+        ctx.die_me();
+        Ok(true)
+    }
+    fn touch_begin(&self, ctx: &mut CollideCtx<'_, V>, c: &HookContact<V>) -> Result<(), Error> {
+        Watcher(self.0.clone()).touch_begin(ctx, c)
+    }
+    fn touch_end(&self, ctx: &mut CollideCtx<'_, V>) -> Result<(), Error> {
+        Watcher(self.0.clone()).touch_end(ctx)
+    }
+}
+
+#[test]
+fn a_critter_dying_in_its_first_touch_still_begins_and_ends_the_spell() {
+    for m in METHODS {
+        let (mut w, seen) = watched::<DVec2>(m.parse().unwrap());
+        let shot = KindDefaults {
+            priority: critterbox::CP_BULLET,
+            radius: 0.2,
+            ..KindDefaults::default()
+        };
+        register(&mut w, "shot", shot, Rc::new(Shot(seen.clone())));
+        let target = w
+            .spawn(CritterSpec::new("watcher", DVec2::new(10.0, 10.0)))
+            .unwrap();
+        let s = w
+            .spawn(CritterSpec::new("shot", DVec2::new(8.0, 10.0)).vel(DVec2::new(6.0, 0.0)))
+            .unwrap();
+        w.run(60).unwrap();
+        assert!(w.get(s).is_none(), "{m}: the shot died");
+        let seen = seen.borrow();
+        assert_eq!(
+            seen.events,
+            vec![
+                (target, s, true),
+                (s, target, true),
+                (target, s, false),
+                (s, target, false)
+            ],
+            "{m}: the spell begins and ends on both sides, lower id first"
+        );
+        assert_eq!(seen.deaths, Vec::<CritterId>::new(), "{m}: no watcher died");
+    }
+}

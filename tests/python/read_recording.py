@@ -31,7 +31,7 @@ def main(path, csv_dir):
         reader = make_reader(f)
         scripts = [a.name for a in reader.iter_attachments()]
     run = meta.get("critterbox")
-    if run is None or run.get("format") != "critterbox-recording/1":
+    if run is None or run.get("format") not in ("critterbox-recording/1", "critterbox-recording/2"):
         failures.append("no critterbox metadata record")
         run = {}
     print(f"scene {run.get('scene')} ({run.get('dim')}D), seed {run.get('seed')}, "

@@ -1,10 +1,13 @@
 //! `critterbox inspect FILE`: what a recording holds: scene, steps, critters by kind, collisions,
-//! deaths, and energy and momentum over time as a table (`--plot` draws them).
+//! deaths, and energy and momentum over time as a table (`--plot` draws them). With `--critter
+//! ID`, one critter's story instead (`critterbox::recording::story`), as text or `--json`.
 
 use super::replay::{damage_outcome, sample, summary_head};
 use crate::plot;
 use clap::Args;
+use critterbox::recording::story::{parse_critter_id, story};
 use critterbox::recording::Recording;
+use critterbox::CritterId;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -20,11 +23,73 @@ pub struct InspectArgs {
     /// Rows of the table over time.
     #[arg(long, default_value_t = 20)]
     pub rows: usize,
+    /// Tell one critter's story instead: its spawn, kind reloads, touching spells and impacts,
+    /// damage, changes of props and colour, and death with its cause. ID as ids print:
+    /// `#20v5`, `20v5`, or `20` for generation 0.
+    #[arg(long, value_name = "ID", value_parser = critter_id)]
+    pub critter: Option<CritterId>,
+    /// With --critter: the story as one JSON document.
+    #[arg(long, requires = "critter")]
+    pub json: bool,
+}
+
+/// Parses a critter id as critterbox prints them.
+fn critter_id(text: &str) -> Result<CritterId, String> {
+    parse_critter_id(text).ok_or_else(|| {
+        format!("'{text}' is not a critter id: write it as ids print, #INDEX or #INDEXvGENERATION (#20, #20v5; the # may be left out)")
+    })
+}
+
+/// `--critter ID`: the critter's story, as text or JSON.
+fn critter_story(
+    rec: &Recording,
+    who: CritterId,
+    json: bool,
+    out: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let story = story(rec, who)?;
+    if json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&story)?)?;
+        return damage_outcome(rec);
+    }
+    let kind = story.kind.as_deref().unwrap_or("?");
+    writeln!(
+        out,
+        "critter      {} ({kind}) in {}",
+        story.critter,
+        rec.path.display()
+    )?;
+    if story.format < 2 {
+        writeln!(
+            out,
+            "note         a format {} recording: it names no causes of spawns, damage and deaths",
+            story.format
+        )?;
+    }
+    let life = match (&story.spawn, &story.death) {
+        (Some(s), Some(d)) => format!("steps {} to {}", s.step(), d.step()),
+        (Some(s), None) => format!(
+            "step {} to the end of the file (step {})",
+            s.step(),
+            story.last_step
+        ),
+        (None, Some(d)) => format!("until step {}", d.step()),
+        (None, None) => "not seen spawned or dying".to_string(),
+    };
+    writeln!(out, "lived        {life}")?;
+    writeln!(out, "timeline")?;
+    for e in &story.timeline {
+        writeln!(out, "  step {:>8}  {}", e.step(), e.text())?;
+    }
+    damage_outcome(rec)
 }
 
 /// Runs the command.
 pub fn run(args: &InspectArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let rec = Recording::open(&args.file)?;
+    if let Some(who) = args.critter {
+        return critter_story(&rec, who, args.json, out);
+    }
     summary_head(&rec, out)?;
     let (first, last) = (rec.totals.first(), rec.totals.last());
     let kinds = |c: Option<(&u64, &std::collections::BTreeMap<String, u64>)>| {

@@ -7,6 +7,7 @@
 use clap::Args;
 use critterbox::recording::replay::{state_at_step, Replay, StateSource};
 use critterbox::recording::schema::{id_of, StateMsg};
+use critterbox::recording::story::prop_text;
 use critterbox::recording::verify::verify;
 use critterbox::recording::{Recording, SceneSource};
 use std::io::Write;
@@ -29,7 +30,8 @@ pub struct ReplayArgs {
     /// every full state; exit non-zero at the first difference.
     #[arg(long)]
     pub verify: bool,
-    /// Print the exact state after step N (re-simulated when it was not recorded).
+    /// Print the exact state after step N (re-simulated when it was not recorded), with each
+    /// critter's own colour and properties.
     #[arg(long, value_name = "N")]
     pub step: Option<u64>,
     /// With --step: print the state as the recording's JSON state message.
@@ -339,7 +341,7 @@ pub fn print_state(out: &mut dyn Write, s: &StateMsg) -> anyhow::Result<()> {
     if dim == 3 {
         head.push("vz");
     }
-    head.extend(["radius", "mass", "health"]);
+    head.extend(["radius", "mass", "health", "color", "props"]);
     writeln!(out, "{}", head.join("\t"))?;
     for i in 0..s.len() {
         let mut row = vec![id_of(s.id[i]).to_string(), s.kind_name(i).to_string()];
@@ -350,6 +352,16 @@ pub fn print_state(out: &mut dyn Write, s: &StateMsg) -> anyhow::Result<()> {
             }
             row.push(fnum(*x));
         }
+        // The recording keys both by the raw id; the table names them as ids print.
+        let key = s.id[i].to_string();
+        row.push(s.colors.get(&key).cloned().unwrap_or_else(|| "-".into()));
+        row.push(s.props.get(&key).map_or("-".into(), |props| {
+            let items: Vec<String> = props
+                .iter()
+                .map(|(name, v)| format!("{name}={}", prop_text(v)))
+                .collect();
+            items.join(" ")
+        }));
         writeln!(out, "{}", row.join("\t"))?;
     }
     Ok(())

@@ -12,11 +12,13 @@ mod auto_islands;
 mod check;
 mod cli;
 mod damaged;
+mod on_damage;
 mod recording;
 mod script_state;
 mod sets;
 mod state_hashes;
 mod stops;
+mod story;
 mod sweep;
 mod test_runner;
 // Only with the cargo feature `rerun` (the file says so with its own `#![cfg]`).

@@ -449,10 +449,7 @@ pub(super) fn register(api: &mut Api) {
         move |a: &mut CritterRef, amount: Dynamic| -> Res<()> {
             let a = a.0;
             let amount = num_or(&amount, "damage")?;
-            with_env!(h, env => {
-                env.damage(a, amount);
-                Ok(())
-            })
+            with_env!(h, env => env.damage(a, amount).map_err(|e| h.carry(e)))
         }
     });
     api.func("die", |h| {
