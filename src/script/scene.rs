@@ -99,11 +99,46 @@ pub(crate) fn load_keeping_sources(
         (e, vec![scene])
     })?;
     let rt = Runtime::new(options, path.parent());
+    load_on(&rt, path, &file, text)
+}
+
+/// As [`load`], for `critterbox check`: a spawn's bad field is noted and left out and the
+/// set-up goes on, so that one bad field does not hide the rest of the scene. Gives the notes
+/// with the outcome.
+pub(crate) fn load_checking(
+    path: &Path,
+    options: &ScriptOptions,
+) -> (Result<Scene, Error>, Vec<ScriptError>) {
+    let file = path.display().to_string();
+    let text = match read_script(path) {
+        Ok(text) => text,
+        Err(e) => return (Err(e), Vec::new()),
+    };
+    let rt = Runtime::new(options, path.parent());
+    *rt.host.check_notes.borrow_mut() = Some(Vec::new());
+    let scene = load_on(&rt, path, &file, text).map_err(|(e, _)| e);
+    let mut notes = rt.host.check_notes.borrow_mut().take().unwrap_or_default();
+    for n in &mut notes {
+        if n.file.is_empty() {
+            n.file.clone_from(&file);
+        }
+    }
+    (scene, notes)
+}
+
+/// Sets up the scene `file`, whose text (any `--set` applied) is `text`, in `rt`.
+fn load_on(
+    rt: &Rc<Runtime>,
+    path: &Path,
+    file: &str,
+    text: String,
+) -> Result<Scene, (Error, Vec<SourceFile>)> {
+    let file = file.to_string();
     rt.sources.borrow_mut().push(SourceFile {
         path: file.clone(),
         text: text.clone(),
     });
-    set_up(&rt, path, &file, &text).map_err(|e| {
+    set_up(rt, path, &file, &text).map_err(|e| {
         let mut read = rt.sources.borrow().clone();
         // A kind file that failed to compile or load is kept only once it loads: add its text.
         if let Error::Script(s) = &e {

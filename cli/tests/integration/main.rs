@@ -12,6 +12,7 @@ mod auto_islands;
 mod check;
 mod cli;
 mod damaged;
+mod ids;
 mod recording;
 mod script_state;
 mod state_hashes;
