@@ -1,7 +1,7 @@
 //! Critters: the disks (2D) and spheres (3D) that move and collide, and the walls they bounce off.
 
-pub use crate::ids::CritterId;
 use crate::ids::KindId;
+pub use crate::ids::{CritterId, ParseCritterIdError};
 use crate::vector::Vector;
 use crate::wall::WallBox;
 use serde::{Deserialize, Serialize};
@@ -374,6 +374,8 @@ pub struct CritterSpec<V: Vector> {
     pub health: Option<f64>,
     /// User properties, added to the kind's.
     pub props: Props,
+    /// Its own colour (a colour name or `#rrggbb`, as `me.color`); the kind's when `None`.
+    pub color: Option<String>,
 }
 
 impl<V: Vector> CritterSpec<V> {
@@ -391,6 +393,7 @@ impl<V: Vector> CritterSpec<V> {
             restitution: None,
             health: None,
             props: Props::new(),
+            color: None,
         }
     }
     /// A plain ball.

@@ -63,8 +63,8 @@ pub mod world;
 pub use border::{Border, Topology};
 pub use broad_phase::BroadPhaseMode;
 pub use critter::{
-    Critter, CritterId, CritterSpec, PropValue, Props, Shape, CP_BULLET, CP_CRITTER, CP_MAXIMUM,
-    CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
+    Critter, CritterId, CritterSpec, ParseCritterIdError, PropValue, Props, Shape, CP_BULLET,
+    CP_CRITTER, CP_MAXIMUM, CP_MINIMUM, CP_PLAYER, CP_SILVERBULLET, CP_WALL,
 };
 pub use critter_set::CritterSet;
 pub use default_response::Hit;

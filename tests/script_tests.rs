@@ -21,9 +21,16 @@ fn main() {
                     jobs: 1,
                     ..TestOptions::default()
                 };
-                match run_one(&case, &options).failure {
+                let outcome = run_one(&case, &options);
+                match outcome.failure {
                     None => Ok(()),
-                    Some(f) => Err(Failed::from(f.to_string())),
+                    // A failing test's own lines come with its failure, as `critterbox test`
+                    // prints them.
+                    Some(f) if outcome.output.is_empty() => Err(Failed::from(f.to_string())),
+                    Some(f) => Err(Failed::from(format!(
+                        "{f}\n---- output ----\n{}",
+                        outcome.output.join("\n")
+                    ))),
                 }
             })
         })

@@ -113,6 +113,9 @@ pub(crate) struct Host {
     pub stashed: RefCell<Option<Box<ScriptError>>>,
     /// The script hooks running, innermost last (for `parent_*` and `contact.impulse`).
     pub frames: RefCell<Vec<super::kind_file::HookFrame>>,
+    /// Under `critterbox check`: the problems a scene's set-up noted and went on from (a
+    /// spawn's bad field is left out), so one does not hide the rest of the scene.
+    pub check_notes: RefCell<Option<Vec<ScriptError>>>,
 }
 
 /// Puts a host's previous target back when dropped, also when a script call unwinds.
@@ -147,6 +150,7 @@ impl Host {
             seed_override: Cell::new(None),
             stashed: RefCell::new(None),
             frames: RefCell::new(Vec::new()),
+            check_notes: RefCell::new(None),
         }
     }
 

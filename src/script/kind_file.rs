@@ -35,7 +35,7 @@ pub(crate) const HOOKS: [(&str, &[usize]); 8] = [
 ];
 
 /// The parameters of hook `name`, as error messages name them.
-fn hook_params(name: &str) -> &'static str {
+pub(crate) fn hook_params(name: &str) -> &'static str {
     match name {
         "init" | "on_death" => "me",
         "update" => "me, dt",

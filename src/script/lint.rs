@@ -1,8 +1,15 @@
 //! `check` as a linter: every file given is checked, and every problem found is reported, not
 //! only the first. Errors are what stops a file from loading (it does not compile, a scene fails
 //! to set up, a kind is invalid); warnings are mistakes that would pass silently: a function
-//! whose name is close to a hook's (`colide`), a hook with the wrong number of parameters, a
-//! kind name in a string literal that names no kind.
+//! whose name is close to a hook's (`colide`), a kind name in a string literal of a kind file
+//! that names no kind.
+//!
+//! A problem's verdict is its own, never another's: loading stops at its first error, so what
+//! the linter can see in the text it reports itself, whatever else is wrong. A hook with the
+//! wrong number of parameters is an error (a kind or scene with one does not load), each one,
+//! not only the first the loader meets; a kind name that names no kind is an error in a scene
+//! (its set-up or `on_step` fails there) and a warning in a kind or test file. A scene's spawn
+//! with a bad field is reported and left out, and the set-up goes on.
 //!
 //! A file is a test file when it defines `fn test_...` functions, a scene when it makes a world,
 //! and a kind otherwise (as `critterbox test` and `run` take them).
@@ -77,6 +84,11 @@ enum FileType {
     Test,
 }
 
+/// True when `text` is a kind file: neither a scene nor a test file.
+pub(crate) fn is_kind_text(text: &str) -> bool {
+    file_type(text) == FileType::Kind
+}
+
 fn file_type(text: &str) -> FileType {
     if fn_defs(text).iter().any(|f| f.name.starts_with("test_")) {
         FileType::Test
@@ -127,19 +139,36 @@ fn fn_defs(text: &str) -> Vec<FnDef> {
     out
 }
 
-fn warning(file: &str, line: usize, column: usize, message: String, hint: String) -> Problem {
+fn problem(
+    severity: Severity,
+    file: &str,
+    (line, column): (usize, usize),
+    message: String,
+    hint: String,
+) -> Problem {
     let mut e = ScriptError::new(file, message);
     e.line = Some(line);
     e.column = Some(column);
     e.hint = Some(hint);
-    Problem {
-        severity: Severity::Warning,
-        error: e,
+    Problem { severity, error: e }
+}
+
+fn warning(file: &str, line: usize, column: usize, message: String, hint: String) -> Problem {
+    problem(Severity::Warning, file, (line, column), message, hint)
+}
+
+/// The parameters of hook `hook`, as the messages name them.
+fn params_of(hook: &str) -> &'static str {
+    if hook == "on_step" {
+        "world"
+    } else {
+        kind_file::hook_params(hook)
     }
 }
 
-/// Warnings for functions named like a hook, and hooks with the wrong number of parameters.
-fn hook_warnings(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Problem> {
+/// Errors for hooks with the wrong number of parameters (every one: the loader stops at the
+/// first), and warnings for functions named like a hook.
+fn hook_problems(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Problem> {
     let mut out = Vec::new();
     for f in fn_defs(text) {
         if let Some((_, arities)) = hooks.iter().find(|(h, _)| *h == f.name) {
@@ -149,17 +178,23 @@ fn hook_warnings(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Prob
                     .map(usize::to_string)
                     .collect::<Vec<_>>()
                     .join(" or ");
-                out.push(warning(
+                out.push(problem(
+                    Severity::Error,
                     file,
-                    f.line,
-                    f.column,
+                    (f.line, f.column),
                     format!(
-                        "hook {} takes {want} parameter{}, not {}",
+                        "hook {} takes {want} parameter{} ({}), not {}",
                         f.name,
                         if arities == &[1] { "" } else { "s" },
+                        params_of(&f.name),
                         f.params
                     ),
-                    "see the hooks in docs/scripting.md".into(),
+                    format!(
+                        "the engine loads no file whose hook takes other parameters: give {} \
+                         the parameters ({}) (see the hooks in docs/scripting.md)",
+                        f.name,
+                        params_of(&f.name)
+                    ),
                 ));
             }
             continue;
@@ -182,8 +217,8 @@ fn hook_warnings(file: &str, text: &str, hooks: &[(&str, &[usize])]) -> Vec<Prob
     out
 }
 
-/// Warnings for kind names in string literals that name no kind.
-fn kind_name_warnings(rt: &Runtime, file: &str, text: &str) -> Vec<Problem> {
+/// Kind names in string literals that name no kind, as problems of `severity`.
+fn kind_name_problems(rt: &Runtime, file: &str, text: &str, severity: Severity) -> Vec<Problem> {
     let known = rt.known_kind_names();
     kind_refs::find(text, &rt.kind_calls)
         .into_iter()
@@ -193,10 +228,10 @@ fn kind_name_warnings(rt: &Runtime, file: &str, text: &str) -> Vec<Problem> {
                 Some(k) => format!("did you mean '{k}'?"),
                 None => format!("the known kinds are {}", known.join(", ")),
             };
-            warning(
+            problem(
+                severity,
                 file,
-                r.line,
-                r.column,
+                (r.line, r.column),
                 format!("unknown kind '{}' in {}", r.name, r.call),
                 hint,
             )
@@ -233,9 +268,12 @@ pub fn check_file(path: &Path, options: &ScriptOptions) -> FileCheck {
     };
     let rt = Runtime::new(options, path.parent());
     let ty = file_type(&text);
+    let mut noted = Vec::new();
     let loaded = match ty {
         FileType::Scene => {
-            super::load_scene(path, &[], options).map(|scene| super::scene_ok(&file, &scene))
+            let (scene, notes) = scene::load_checking(path, options);
+            noted = notes;
+            scene.map(|scene| super::scene_ok(&file, &scene))
         }
         FileType::Kind => kind_file::load_def(&rt, &file).map(|def| {
             let hooks: Vec<&str> = def.hook_names().collect();
@@ -257,24 +295,44 @@ pub fn check_file(path: &Path, options: &ScriptOptions) -> FileCheck {
             format!("{file}: tests ok ({n} tests)")
         }),
     };
+    let mut loading: Vec<Problem> = noted
+        .into_iter()
+        .map(|error| Problem {
+            severity: Severity::Error,
+            error,
+        })
+        .collect();
     match loaded {
-        Ok(summary) => report.summary = Some(summary),
-        Err(e) => report.problems.push(as_problem(e, &file)),
+        // A scene that set up only without its bad spawn fields did not load as written.
+        Ok(summary) if loading.is_empty() => report.summary = Some(summary),
+        Ok(_) => {}
+        Err(e) => loading.push(as_problem(e, &file)),
     }
-    let mut warnings = match ty {
-        FileType::Kind => hook_warnings(&file, &text, KIND_HOOKS),
-        FileType::Scene => hook_warnings(&file, &text, SCENE_HOOKS),
+    let mut linted = match ty {
+        FileType::Kind => hook_problems(&file, &text, KIND_HOOKS),
+        FileType::Scene => hook_problems(&file, &text, SCENE_HOOKS),
         FileType::Test => Vec::new(),
     };
-    warnings.extend(kind_name_warnings(&rt, &file, &text));
+    let unknown_kind = match ty {
+        FileType::Scene => Severity::Error,
+        FileType::Kind | FileType::Test => Severity::Warning,
+    };
+    linted.extend(kind_name_problems(&rt, &file, &text, unknown_kind));
+    let (mut errors, mut warnings): (Vec<Problem>, Vec<Problem>) = linted
+        .into_iter()
+        .partition(|p| p.severity == Severity::Error);
+    // The loader's error on a line the linter names is the same problem (the first wrong hook,
+    // the unknown kind it stopped at): the linter's says it as for the others.
+    let place = |p: &Problem| (p.error.file.clone(), p.error.line);
+    let linted_lines: Vec<_> = errors.iter().map(place).collect();
+    loading.retain(|p| !linted_lines.contains(&place(p)));
+    errors.extend(loading);
+    errors.sort_by_key(|p| (p.error.file != file, p.error.line, p.error.column));
     // A warning on a line an error already names says nothing new.
-    let error_lines: Vec<(String, Option<usize>)> = report
-        .problems
-        .iter()
-        .map(|p| (p.error.file.clone(), p.error.line))
-        .collect();
-    warnings.retain(|w| !error_lines.contains(&(w.error.file.clone(), w.error.line)));
+    let error_lines: Vec<_> = errors.iter().map(place).collect();
+    warnings.retain(|w| !error_lines.contains(&place(w)));
     warnings.sort_by_key(|w| (w.error.line, w.error.column));
+    report.problems = errors;
     report.problems.extend(warnings);
     report
 }
@@ -301,10 +359,20 @@ mod tests {
     #[test]
     fn near_hook_names_warn_and_exact_ones_do_not() {
         let text = "fn colide(me, other) {}\nfn colides_with(me, other) {}\nfn updat(me, dt) {}\nfn touch_begn(me, other, c) {}\nfn on_deth(me) {}\nfn collide(me, other) {}\nfn is_target(me, other) {}\nfn init(me, extra) {}\n";
-        let w = hook_warnings("k.rhai", text, KIND_HOOKS);
+        let w = hook_problems("k.rhai", text, KIND_HOOKS);
         let lines: Vec<usize> = w.iter().filter_map(|p| p.error.line).collect();
         assert_eq!(lines, vec![1, 2, 3, 4, 5, 8], "{w:#?}");
         assert!(w[0].error.message.contains("'collide'"));
         assert!(w[5].error.message.contains("takes 1"));
+        let errors: Vec<usize> = w
+            .iter()
+            .filter(|p| p.severity == Severity::Error)
+            .filter_map(|p| p.error.line)
+            .collect();
+        assert_eq!(
+            errors,
+            vec![8],
+            "a wrong arity is an error, a near name a warning"
+        );
     }
 }

@@ -199,7 +199,8 @@ impl Runtime {
         self.unknown_warned.borrow_mut().insert(name.to_string())
     }
 
-    /// The names of every kind on the kind search path, and the native ones.
+    /// The names of every kind on the kind search path (its files that are neither scenes nor
+    /// test files), and the native ones.
     pub fn known_kind_names(&self) -> Vec<String> {
         let mut names: Vec<String> = kind_refs::NATIVE_KINDS
             .iter()
@@ -211,7 +212,10 @@ impl Runtime {
             };
             for entry in entries.flatten() {
                 let path = entry.path();
-                if path.extension().is_some_and(|e| e == "rhai") {
+                // A scene's own folder is on the path, and scenes and tests are no kinds.
+                let is_kind =
+                    || std::fs::read_to_string(&path).is_ok_and(|t| lint::is_kind_text(&t));
+                if path.extension().is_some_and(|e| e == "rhai") && is_kind() {
                     if let Some(stem) = path.file_stem() {
                         names.push(stem.to_string_lossy().into_owned());
                     }

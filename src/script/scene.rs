@@ -245,17 +245,54 @@ pub(crate) fn load_keeping_sources(
     let text = apply_sets(&file, &raw, &scene_sets).map_err(scene_only)?;
     let rt = Runtime::new(options, path.parent());
     give_kind_sets(&rt, &file, &kind_sets).map_err(scene_only)?;
+    load_on(&rt, path, &file, text, &kind_sets)
+}
+
+/// As [`load`], for `critterbox check`: a spawn's bad field is noted and left out and the
+/// set-up goes on, so that one bad field does not hide the rest of the scene. Gives the notes
+/// with the outcome.
+pub(crate) fn load_checking(
+    path: &Path,
+    options: &ScriptOptions,
+) -> (Result<Scene, Error>, Vec<ScriptError>) {
+    let file = path.display().to_string();
+    let text = match read_script(path) {
+        Ok(text) => text,
+        Err(e) => return (Err(e), Vec::new()),
+    };
+    let rt = Runtime::new(options, path.parent());
+    *rt.host.check_notes.borrow_mut() = Some(Vec::new());
+    let scene = load_on(&rt, path, &file, text, &[]).map_err(|(e, _)| e);
+    let mut notes = rt.host.check_notes.borrow_mut().take().unwrap_or_default();
+    for n in &mut notes {
+        if n.file.is_empty() {
+            n.file.clone_from(&file);
+        }
+    }
+    (scene, notes)
+}
+
+/// Sets up the scene `file`, whose text (any `--set` applied) is `text`, in `rt`; every kind
+/// `kind_sets` names must then be known.
+fn load_on(
+    rt: &Rc<Runtime>,
+    path: &Path,
+    file: &str,
+    text: String,
+    kind_sets: &[KindSet],
+) -> Result<Scene, (Error, Vec<SourceFile>)> {
+    let file = file.to_string();
     rt.sources.borrow_mut().push(SourceFile {
         path: file.clone(),
         text: text.clone(),
     });
-    let built = set_up(&rt, path, &file, &text).and_then(|scene| {
+    let built = set_up(rt, path, &file, &text).and_then(|scene| {
         // A kind not found by name on the search path may have been loaded by its path.
         let unknown = |s: &&KindSet| {
             !rt.kinds.borrow().contains_key(&s.kind) && rt.resolve_kind(&s.kind).is_none()
         };
         match kind_sets.iter().find(unknown) {
-            Some(set) => Err(unknown_kind_set(&rt, &file, set)),
+            Some(set) => Err(unknown_kind_set(rt, &file, set)),
             None => Ok(scene),
         }
     });

@@ -302,6 +302,17 @@ impl<V: Vector> State<V> {
             }
         }
         let fixed = spec.fixed.unwrap_or(d.fixed);
+        let color = match spec.color.as_deref() {
+            Some(c) => Some(
+                crate::color::checked(c).map_err(|reason| Error::InvalidCritter {
+                    critter: who(),
+                    field: "color",
+                    value: c.to_string(),
+                    reason,
+                })?,
+            ),
+            None => None,
+        };
         Ok(Critter {
             id: CritterId {
                 index: 0,
@@ -328,7 +339,7 @@ impl<V: Vector> State<V> {
                     props.extend(spec.props);
                     props
                 },
-                color: None,
+                color,
             }),
         })
     }

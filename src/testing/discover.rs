@@ -5,10 +5,19 @@ use crate::error::{Error, ScriptError};
 use crate::script::{Runtime, ScriptOptions};
 use std::path::PathBuf;
 
-/// Test script files under `paths` (files as given; folders searched for `*.rhai`), sorted.
+/// Test script files under `paths` (files as given; folders searched for `*.rhai`), sorted. A
+/// path that is not there is an error: it was meant to hold tests.
 pub fn find_test_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
     let mut files = Vec::new();
     for p in paths {
+        if !p.exists() {
+            let mut e = ScriptError::new(
+                p.display().to_string(),
+                "no such file or folder: it was given as a test script or a folder of them",
+            );
+            e.hint = Some("test scripts are .rhai files with fn test_*() functions; paths are relative to the working directory".into());
+            return Err(Error::from(e));
+        }
         if p.is_dir() {
             let entries = std::fs::read_dir(p).map_err(|e| {
                 Error::from(ScriptError::new(

@@ -28,14 +28,26 @@ pub fn junit_xml(outcomes: &[TestOutcome]) -> String {
             }),
             o.duration.as_secs_f64()
         ));
-        match &o.failure {
-            None => xml.push_str("/>\n"),
-            Some(f) => xml.push_str(&format!(
-                ">\n      <failure message=\"{}\">{}</failure>\n    </testcase>\n",
+        if o.failure.is_none() && o.output.is_empty() {
+            xml.push_str("/>\n");
+            continue;
+        }
+        xml.push_str(">\n");
+        if let Some(f) = &o.failure {
+            xml.push_str(&format!(
+                "      <failure message=\"{}\">{}</failure>\n",
                 esc(&f.message),
                 esc(&f.to_string())
-            )),
+            ));
         }
+        // What the test printed, where CI systems show a test's output.
+        if !o.output.is_empty() {
+            xml.push_str(&format!(
+                "      <system-out>{}</system-out>\n",
+                esc(&o.output.join("\n"))
+            ));
+        }
+        xml.push_str("    </testcase>\n");
     }
     xml.push_str("  </testsuite>\n</testsuites>\n");
     xml

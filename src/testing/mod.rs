@@ -3,13 +3,15 @@
 //! [`discover`] lists the tests of the files [`find_test_files`] finds; [`run_tests`] runs them
 //! on worker threads, each in a fresh runtime (rhai engines are not shared across threads) whose
 //! engine also has the test API (`asserts.rs`; the test's world, `world.rs`); each test's run is
-//! recorded and kept if it fails (`record.rs`); [`junit_xml`] reports for CI systems. This layer
+//! recorded and kept if it fails (`record.rs`), and what it prints is kept with its outcome
+//! (`output.rs`); [`junit_xml`] reports for CI systems. This layer
 //! sits above scripts and recordings: it adds its functions to a runtime through the script
 //! layer's extension point, and keeps its own state.
 
 mod asserts;
 mod discover;
 mod junit;
+mod output;
 mod record;
 mod run;
 mod world;
@@ -52,7 +54,15 @@ pub struct TestOutcome {
     pub failure: Option<ScriptError>,
     /// How long it ran.
     pub duration: Duration,
+    /// What it printed: the `print`, `debug` and `log` lines of the test, its scene and its
+    /// kinds' hooks, in order; a line logged in a step is prefixed `[step k]`, as `run` prints
+    /// it. At most [`MAX_OUTPUT_LINES`] are kept, then a line saying how many more there were.
+    pub output: Vec<String>,
 }
+
+/// The most output lines kept of one test: a test that logs in every hook of a big world
+/// would otherwise hold them all in memory.
+pub const MAX_OUTPUT_LINES: usize = 10_000;
 
 /// Settings for a test run.
 #[derive(Clone, Debug)]

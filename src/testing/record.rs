@@ -3,7 +3,7 @@
 //! with `--bless` writes it.
 
 use super::run::TestRun;
-use super::world::{flat, with_scene};
+use super::world::{flat, step_once, with_scene};
 use crate::recording::keyframes::default_record_every;
 use crate::recording::{EndMeta, Recorder, Recording, RunMeta, RunOverrides, SceneSource};
 use crate::scenes::{AnyWorld, Scene, SourceFile};
@@ -156,7 +156,7 @@ fn expect_matches_recording(host: &Host, run: &TestRun, path: &str) -> Res<()> {
             return Ok(());
         }
         run.check_deadline()?;
-        let stop = with_scene(host, |s| s.step())?.map_err(|e| error(flat(&e)))?;
+        let stop = step_once(host, run)?.1.map_err(|e| error(flat(&e)))?;
         if stop.is_some() && step + 1 < last {
             return fail(format!(
                 "the scene stopped at step {} but {path} goes on to step {last}",
@@ -186,7 +186,7 @@ fn bless(host: &Host, run: &TestRun, file: &Path, path: &str) -> Res<()> {
     )?;
     while with_scene(host, |s| s.world.step_count())? < steps {
         run.check_deadline()?;
-        let stop = with_scene(host, |s| s.step())?.map_err(|e| error(flat(&e)))?;
+        let stop = step_once(host, run)?.1.map_err(|e| error(flat(&e)))?;
         with_scene(host, |s| rec.record(&s.world))?.map_or_else(|e| fail(e.to_string()), Ok)?;
         if stop.is_some() {
             break;

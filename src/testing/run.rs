@@ -29,6 +29,8 @@ pub(super) struct TestRun {
     pub bless: bool,
     /// The recording of the test's run (kept only if the test fails).
     pub recorder: RefCell<Option<Recorder>>,
+    /// What the test printed.
+    pub output: super::output::Output,
 }
 
 impl TestRun {
@@ -53,6 +55,7 @@ impl Extension for TestRun {
             }
             None
         });
+        super::output::register(api, &self);
         super::world::register(api, &self);
         super::asserts::register(api, &self);
         record::register(api, &self);
@@ -66,7 +69,8 @@ impl Extension for TestRun {
 /// Runs one test in a fresh runtime.
 pub fn run_one(case: &TestCase, options: &TestOptions) -> TestOutcome {
     let started = Instant::now();
-    let failure = run_case(case, options).err().map(|e| match e {
+    let mut output = Vec::new();
+    let failure = run_case(case, options, &mut output).err().map(|e| match e {
         Error::Script(s) => *s,
         other => ScriptError::new(case.file.display().to_string(), other.to_string()),
     });
@@ -74,10 +78,12 @@ pub fn run_one(case: &TestCase, options: &TestOptions) -> TestOutcome {
         case: case.clone(),
         failure,
         duration: started.elapsed(),
+        output,
     }
 }
 
-fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
+/// Runs the test; `output` gets what it printed.
+fn run_case(case: &TestCase, options: &TestOptions, output: &mut Vec<String>) -> Result<(), Error> {
     let file = case.file.display().to_string();
     let text = read_script(&case.file)?;
     let record_to = options.record_failures.as_ref().map(|dir| {
@@ -94,6 +100,7 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
         record_to,
         bless: options.bless,
         recorder: RefCell::new(None),
+        output: Default::default(),
     });
     let rt = Runtime::extended(&options.script, case.file.parent(), Some(run.clone()));
     let ast = rt.compile(&file, &text)?;
@@ -112,6 +119,10 @@ fn run_case(case: &TestCase, options: &TestOptions) -> Result<(), Error> {
         (),
     );
     let scene = rt.host.take_scene();
+    if let Some(scene) = &scene {
+        run.output.keep(scene.world.log(), None);
+    }
+    *output = run.output.take();
     let recorder = run.recorder.borrow_mut().take();
     let kept = match (recorder, &scene) {
         (Some(rec), Some(scene)) => {

@@ -40,11 +40,25 @@ pub(super) fn flat(e: &Error) -> String {
     }
 }
 
+/// One step of the test's scene (and its `on_step`), keeping the lines logged before it and in
+/// it for the test's output. Gives the steps taken before it, and the step's outcome.
+pub(super) fn step_once(host: &Host, run: &TestRun) -> Res<(u64, Result<Option<String>, Error>)> {
+    with_scene(host, |scene| {
+        let step = scene.world.step_count();
+        run.output.keep(scene.world.log(), None);
+        run.output.log_cleared();
+        let outcome = scene.step();
+        // Kept when the step failed too: what it logged on the way explains the failure.
+        run.output.keep(scene.world.log(), Some(step + 1));
+        (step, outcome)
+    })
+}
+
 /// Steps the test's world `n` times (recording each step), or until its scene stops it.
 pub(super) fn step_scene(host: &Host, run: &TestRun, n: INT) -> Res<()> {
     for _ in 0..n.max(0) {
         run.check_deadline()?;
-        let (step, outcome) = with_scene(host, |scene| (scene.world.step_count(), scene.step()))?;
+        let (step, outcome) = step_once(host, run)?;
         if outcome.is_ok() {
             record::step(host, run)?;
         }

@@ -8,9 +8,11 @@ use std::path::PathBuf;
 /// Arguments of `critterbox check`.
 #[derive(Args, Debug)]
 #[command(after_help = "\
-Every file is checked and every problem reported: errors (the file does not load) first, then \
-warnings (a function named like a hook, e.g. `colide`; a hook with the wrong number of \
-parameters; a kind name in a string literal that names no kind).
+Every file is checked and every problem reported in one pass, each with a verdict of its own: \
+errors first (the file does not load; a hook with the wrong number of parameters, each one; a \
+scene's spawn with a bad field, which is left out so the rest of the scene is checked; a kind \
+name in a scene's string literal that names no kind), then warnings (a function named like a \
+hook, e.g. `colide`; a kind name in a kind's or test's string literal that names no kind).
 
 Exit codes: 0 no errors (warnings allowed, unless --strict); 1 an error in some file, or a \
 warning under --strict; 2 bad arguments.")]

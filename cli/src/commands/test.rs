@@ -13,6 +13,9 @@ use std::time::Duration;
 
 /// Arguments of `critterbox test`.
 #[derive(Args, Debug)]
+#[command(after_help = "\
+Exit codes: 0 every test passed; 1 a test failed, or there was nothing to run (a path that is not \
+there, no test files, no fn test_*() in them, a --filter that matches none); 2 bad arguments.")]
 pub struct TestArgs {
     /// Test scripts or folders of them (default: scripts/tests).
     pub paths: Vec<PathBuf>,
@@ -28,6 +31,10 @@ pub struct TestArgs {
     /// Seconds one test may run before it fails.
     #[arg(long, default_value_t = 60)]
     pub timeout: u64,
+    /// Print every test's output (its `print`, `debug` and `log` lines, and its kinds' and
+    /// scene's), passing or failing, under the test's name; a failing test's is printed always.
+    #[arg(long)]
+    pub show_output: bool,
     /// Rewrite the golden recordings that tests compare with (`expect_matches_recording`).
     #[arg(long)]
     pub bless: bool,
@@ -48,20 +55,40 @@ pub struct TestArgs {
     pub watch: bool,
 }
 
-/// Runs the tests; any failure is an error (non-zero exit) after every test has run.
+/// Runs the tests; any failure is an error (non-zero exit) after every test has run, and so is
+/// finding nothing to run (no such path, no test files, no tests in them, a filter that
+/// matches none): a run that tested nothing must not pass.
 pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     let paths = if args.paths.is_empty() {
         vec![PathBuf::from("scripts/tests")]
     } else {
         args.paths.clone()
     };
+    let missing: Vec<PathBuf> = paths.iter().filter(|p| !p.exists()).cloned().collect();
+    if !missing.is_empty() {
+        anyhow::bail!(
+            "nothing to run: {} {} not there (in {}); {LOOKS_FOR}",
+            show_paths(&missing),
+            if missing.len() == 1 { "is" } else { "are" },
+            here()
+        );
+    }
     let files = find_test_files(&paths)?;
     anyhow::ensure!(
         !files.is_empty(),
-        "no test scripts in {}",
-        show_paths(&paths)
+        "nothing to run: no test scripts (*.rhai) in {} (in {}); {LOOKS_FOR}",
+        show_paths(&paths),
+        here()
     );
     let cases = discover(&files, args.filter.as_deref());
+    if args.filter.is_none() && cases.is_empty() {
+        anyhow::bail!(
+            "nothing to run: no tests in {} (in {}): a test is a function named test_... \
+             that takes no parameters, e.g. `fn test_ball_bounces() {{ ... }}`",
+            show_paths(&files),
+            here()
+        );
+    }
     if let (Some(filter), true) = (&args.filter, cases.is_empty()) {
         let all = discover(&files, None).len();
         anyhow::bail!(
@@ -96,7 +123,13 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
         },
         bless: args.bless,
     };
-    let failed = run_cases(&cases, &options, args.junit.as_deref(), out)?;
+    let failed = run_cases(
+        &cases,
+        &options,
+        args.junit.as_deref(),
+        args.show_output,
+        out,
+    )?;
     if args.watch {
         return watch_tests(args, &files, &options, out);
     }
@@ -108,12 +141,14 @@ pub fn run(args: &TestArgs, out: &mut dyn Write) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Runs `cases`, printing a line per test and the totals (and JUnit XML to `junit`); returns
-/// how many failed.
+/// Runs `cases`, printing a line per test and the totals (and JUnit XML to `junit`); a failing
+/// test's output follows its line, and every test's under `show_output`. Returns how many
+/// failed.
 fn run_cases(
     cases: &[critterbox::testing::TestCase],
     options: &TestOptions,
     junit: Option<&std::path::Path>,
+    show_output: bool,
     out: &mut dyn Write,
 ) -> anyhow::Result<usize> {
     let mut report = |o: &TestOutcome| {
@@ -127,6 +162,13 @@ fn run_cases(
                 f.to_string().replace('\n', "\n       ")
             ),
         };
+        if (show_output || o.failure.is_some()) && !o.output.is_empty() {
+            // Grouped under the test's name, as `cargo test` prints a test's stdout.
+            let _ = writeln!(out, "---- {} output ----", o.case.id());
+            for line in &o.output {
+                let _ = writeln!(out, "{line}");
+            }
+        }
     };
     let outcomes = run_tests(cases, options, &mut report);
     let failed = outcomes.iter().filter(|o| o.failure.is_some()).count();
@@ -174,7 +216,13 @@ fn watch_tests(
             cases.len(),
             show_paths(&affected)
         )?;
-        run_cases(&cases, options, args.junit.as_deref(), out)?;
+        run_cases(
+            &cases,
+            options,
+            args.junit.as_deref(),
+            args.show_output,
+            out,
+        )?;
     }
 }
 
@@ -265,6 +313,17 @@ fn scenes_named(test: &std::path::Path, text: &str) -> Vec<PathBuf> {
         }
     }
     found
+}
+
+/// What `critterbox test` runs, for the errors that found nothing to run.
+const LOOKS_FOR: &str =
+    "critterbox test runs every fn test_*() in the .rhai files it is given, or \
+    in those of the folders it is given (default: scripts/tests, relative to where it runs); give \
+    test files or folders, or run it in the project's root";
+
+/// The working directory, which relative paths are read from.
+fn here() -> String {
+    std::env::current_dir().map_or_else(|_| ".".to_string(), |d| d.display().to_string())
 }
 
 fn parse_shard(s: &str) -> Result<Shard, String> {

@@ -12,6 +12,7 @@ mod auto_islands;
 mod check;
 mod cli;
 mod damaged;
+mod ids;
 mod on_damage;
 mod recording;
 mod script_state;

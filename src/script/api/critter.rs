@@ -11,7 +11,7 @@ use crate::script::host::{with_env, Host};
 use crate::step::spawn::check_radius_in_box;
 use crate::vector::{fmt_vec, Vector};
 use glam::DVec3;
-use rhai::{Dynamic, EvalAltResult, INT};
+use rhai::{Dynamic, EvalAltResult};
 
 /// A handle to a critter, as scripts see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -234,7 +234,9 @@ pub(super) fn register(api: &mut Api) {
             }
         });
     }
-    critter_field!(api, "id", |c| c.id().index as INT);
+    // The id as every log, recording and `inspect` prints it (`#20v5`): a text, so it compares
+    // with `==`, keys a map and reads in an interpolation; never reused (its generation).
+    critter_field!(api, "id", |c| c.id().to_string());
     {
         api.get("kind", |h| {
             move |r: &mut CritterRef| -> Res<String> {

@@ -395,6 +395,13 @@ fn spawn_syntax(
     } else {
         kind.to_string()
     };
+    // Under `critterbox check`, a bad field is reported and left out, and the scene goes on.
+    let map = if in_world {
+        let file = ctx.source().unwrap_or_default().to_string();
+        super::spawn::note_bad_fields(h, &kind, map, &file, inputs[0].position())
+    } else {
+        map
+    };
     let origin = if in_world {
         None
     } else {

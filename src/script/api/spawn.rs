@@ -31,6 +31,7 @@ const SPAWN_FIELDS: &[&str] = &[
     "priority",
     "restitution",
     "health",
+    "color",
     "props",
     "on_overlap",
 ];
@@ -52,6 +53,21 @@ pub(crate) fn spec_from_map<V: Vector>(kind: &str, map: &Map) -> Res<CritterSpec
             "priority" => spec.priority = Some(f("priority")?),
             "restitution" => spec.restitution = Some(f("restitution")?),
             "health" => spec.health = Some(f("health")?),
+            // As a kind's `color` default and `me.color`: a colour name or "#rrggbb"; `()` is
+            // the kind's colour.
+            "color" => match value.clone().try_cast::<rhai::ImmutableString>() {
+                Some(c) => match crate::color::checked(&c) {
+                    Ok(c) => spec.color = Some(c),
+                    Err(why) => return fail(format!("color \"{c}\" of the {kind} to spawn: {why}")),
+                },
+                None if value.is_unit() => spec.color = None,
+                None => {
+                    return fail(format!(
+                        "color must be a string (a colour name or \"#rrggbb\"), or () for the kind's colour; got {}",
+                        super::values::type_of(value)
+                    ))
+                }
+            },
             "fixed" => match value.clone().try_cast::<bool>() {
                 Some(b) => spec.fixed = Some(b),
                 None => return fail("fixed must be true or false"),
@@ -67,14 +83,55 @@ pub(crate) fn spec_from_map<V: Vector>(kind: &str, map: &Map) -> Res<CritterSpec
                 None => return fail("props must be a map, e.g. props: #{ score: 0 }"),
             },
             other => {
+                let near = crate::script::kind_refs::closest(other, SPAWN_FIELDS.iter().copied())
+                    .map(|f| format!("did you mean '{f}'? "))
+                    .unwrap_or_default();
                 return fail(format!(
-                    "unknown field '{other}' for a spawn; the fields are {}; user properties go in props: #{{ ... }}",
+                    "unknown field '{other}' for a spawn; the fields are {}{HINT_MARK}{near}user properties go in props: #{{ ... }}",
                     SPAWN_FIELDS.join(", ")
-                ))
+                ));
             }
         }
     }
     Ok(spec)
+}
+
+/// Under `critterbox check` (the host keeps notes): every field of `map` that a spawn would
+/// refuse is noted, as the error the spawn at `pos` in `file` would give, and left out, so the
+/// set-up goes on past it. Elsewhere `map` comes back whole and a bad field is the spawn's error.
+pub(crate) fn note_bad_fields(
+    host: &Host,
+    kind: &str,
+    map: Map,
+    file: &str,
+    pos: rhai::Position,
+) -> Map {
+    let mut notes = host.check_notes.borrow_mut();
+    let Some(notes) = notes.as_mut() else {
+        return map;
+    };
+    let mut kept = Map::new();
+    for (key, value) in map {
+        let one: Map = std::iter::once((key.clone(), value.clone())).collect();
+        let checked = spec_from_map::<glam::DVec3>(kind, &one)
+            .and_then(|_| on_overlap_of(&one, OnOverlap::Error).map(drop));
+        match checked {
+            Ok(()) => {
+                kept.insert(key, value);
+            }
+            Err(mut e) => {
+                e.set_position(pos);
+                notes.push(crate::script::errors::eval_error(
+                    file,
+                    None,
+                    None,
+                    &e,
+                    u64::MAX,
+                ));
+            }
+        }
+    }
+    kept
 }
 
 /// Counts one spawn against the limit of the step `step`.

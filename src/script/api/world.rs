@@ -1,12 +1,13 @@
 //! `World`: the running world as scripts see it (`world()`, `w.step_count`, `w.time`, `w.dt`,
-//! `w.gravity`,
-//! `w.critters_of(kind)`, `w.count(kind)`), and its log: `log(...)`, `print` and `debug`.
+//! `w.gravity`, `w.critters_of(kind)`, `w.count(kind)`, `w.critter(id)`), and its log:
+//! `log(...)`, `print` and `debug`.
 
 use super::critter::CritterRef;
 use super::registry::Api;
 use super::values::to_svec;
-use super::{error, Res};
-use crate::script::host::with_env;
+use super::{error, fail_hint, Res};
+use crate::critter::CritterId;
+use crate::script::host::{with_env, Host};
 use glam::DVec3;
 use rhai::{Array, Dynamic, EvalAltResult, INT};
 
@@ -69,6 +70,37 @@ pub(super) fn register(api: &mut Api) {
             with_env!(h, env => Ok(env.critters_of(k).len() as INT))
         }
     });
+    api.func("critter", |h| {
+        move |_: &mut WorldRef, id: &str| -> Res<Dynamic> {
+            match id.parse::<CritterId>() {
+                Ok(id) => live_critter(&h, id),
+                Err(e) => fail_hint(
+                    format!("world().critter(\"{id}\"): {e}"),
+                    "pass an id as me.id gives it, e.g. world().critter(\"#20v5\")",
+                ),
+            }
+        }
+    });
+    api.func("critter", |h| {
+        move |_: &mut WorldRef, index: INT| -> Res<Dynamic> {
+            match u32::try_from(index) {
+                Ok(index) => live_critter(
+                    &h,
+                    CritterId {
+                        index,
+                        generation: 0,
+                    },
+                ),
+                Err(_) => fail_hint(
+                    format!(
+                        "world().critter({index}): an id's index is a number from 0 to {}",
+                        u32::MAX
+                    ),
+                    "pass an id as me.id gives it, e.g. world().critter(\"#20v5\")",
+                ),
+            }
+        }
+    });
     api.func("log", |h| {
         move |_: &mut WorldRef, line: Dynamic| -> Res<()> {
             with_env!(h, env => {
@@ -85,4 +117,16 @@ pub(super) fn register(api: &mut Api) {
             })
         }
     });
+}
+
+/// `world().critter(id)`: the handle of the live critter `id`, or `()` when none is (it died,
+/// or the id was never given out); the generation must match, so an old id finds nothing.
+fn live_critter(h: &Host, id: CritterId) -> Res<Dynamic> {
+    with_env!(h, env => {
+        let access = env.access().map_err(error)?;
+        Ok(match access.get(id) {
+            Some(c) if c.is_alive() => Dynamic::from(CritterRef(id)),
+            _ => Dynamic::UNIT,
+        })
+    })
 }
