@@ -19,25 +19,6 @@ use serde::Serialize;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 
-/// Reads a critter id as critterbox prints it: `#20v5`, `20v5`, or `#20` / `20` for generation
-/// 0. `None` when the text is not one.
-pub fn parse_critter_id(text: &str) -> Option<CritterId> {
-    let t = text.trim();
-    let t = t.strip_prefix('#').unwrap_or(t);
-    let (index, generation) = match t.split_once('v') {
-        Some((i, g)) => (i, g),
-        None => (t, "0"),
-    };
-    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    if !digits(index) || !digits(generation) {
-        return None;
-    }
-    Some(CritterId {
-        index: index.parse().ok()?,
-        generation: generation.parse().ok()?,
-    })
-}
-
 /// One critter's story (see the module docs). Serialised as `inspect --critter ID --json`
 /// prints it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -251,7 +232,7 @@ pub fn prop_text(v: &PropValue) -> String {
 /// A JSON value as [`prop_text`] writes the property it came from.
 pub fn json_text(v: &Value) -> String {
     match v {
-        Value::String(s) if parse_critter_id(s).is_some() && s.starts_with('#') => s.clone(),
+        Value::String(s) if s.starts_with('#') && s.parse::<CritterId>().is_ok() => s.clone(),
         other => other.to_string(),
     }
 }

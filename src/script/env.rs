@@ -111,6 +111,17 @@ impl<V: Vector> Env<'_, V> {
         }
     }
 
+    /// The step that what a script does now is filed under, in the log's `[step k]` and the
+    /// recording: the one running (k, where `step_count` is k - 1) inside a step; the last one
+    /// taken between steps (`on_step` after step k, a test or scene between steps).
+    pub(crate) fn step_now(&self) -> u64 {
+        match self {
+            Env::World(w) => w.step_count(),
+            Env::Hook(a) => a.step() + 1,
+            Env::Pair(_) => 0,
+        }
+    }
+
     pub(crate) fn time(&self) -> f64 {
         match self {
             Env::World(w) => w.time(),

@@ -397,7 +397,9 @@ fn endless_loop_in_update_stops_at_the_operation_limit() {
     assert!(f.err.hint.is_some(), "a hint: {}", f.err);
 }
 
-const TYPO_KIND: &str = "fn update(me, dt) {\n    me.velocity = vec(1, 0);\n}\n";
+/// A property no kind declared and no field is near (`me.velocity` gets "did you mean `vel`?",
+/// `scripts/tests/field_typos.rhai`).
+const TYPO_KIND: &str = "fn update(me, dt) {\n    me.heading = vec(1, 0);\n}\n";
 
 #[test]
 fn typo_in_a_property_set_is_an_error_suggesting_set_prop() {
@@ -408,9 +410,9 @@ fn typo_in_a_property_set_is_an_error_suggesting_set_prop() {
         &format!("{WORLD}spawn(\"typo\", #{{ pos: vec(5, 5) }});\n"),
     );
     let f = fail(&scene, &ScriptOptions::default(), "typo", 5);
-    assert_place(&f.err, &kind, 2, span_of(TYPO_KIND, 2, "me.velocity"));
+    assert_place(&f.err, &kind, 2, span_of(TYPO_KIND, 2, "me.heading"));
     assert_hook(&f, "typo", "update");
-    assert!(f.err.message.contains("velocity"), "{}", f.err);
+    assert!(f.err.message.contains("heading"), "{}", f.err);
     assert!(f.err.to_string().contains("set_prop"), "{}", f.err);
 }
 

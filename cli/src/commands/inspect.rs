@@ -5,7 +5,7 @@
 use super::replay::{damage_outcome, sample, summary_head};
 use crate::plot;
 use clap::Args;
-use critterbox::recording::story::{parse_critter_id, story};
+use critterbox::recording::story::story;
 use critterbox::recording::Recording;
 use critterbox::CritterId;
 use std::io::Write;
@@ -35,9 +35,8 @@ pub struct InspectArgs {
 
 /// Parses a critter id as critterbox prints them.
 fn critter_id(text: &str) -> Result<CritterId, String> {
-    parse_critter_id(text).ok_or_else(|| {
-        format!("'{text}' is not a critter id: write it as ids print, #INDEX or #INDEXvGENERATION (#20, #20v5; the # may be left out)")
-    })
+    text.parse()
+        .map_err(|e: critterbox::ParseCritterIdError| e.to_string())
 }
 
 /// `--critter ID`: the critter's story, as text or JSON.

@@ -8,9 +8,7 @@ use common::{critterbox_in, text, ROOT};
 
 use critterbox::recording::export::export_csv;
 use critterbox::recording::schema::{id_of, LifecycleMsg};
-use critterbox::recording::story::parse_critter_id;
 use critterbox::recording::Recording;
-use critterbox::CritterId;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -103,24 +101,6 @@ type Event<'a, T> = (u64, T, Option<u64>, Option<&'a str>, &'a str);
 /// The recording's lifecycle messages, read with the library.
 fn lifecycle(file: &Path) -> Vec<LifecycleMsg> {
     Recording::open(file).expect("readable").lifecycle
-}
-
-#[test]
-fn ids_are_read_as_they_print() {
-    let id = |index, generation| Some(CritterId { index, generation });
-    assert_eq!(parse_critter_id("#20v5"), id(20, 5));
-    assert_eq!(parse_critter_id("20v5"), id(20, 5));
-    assert_eq!(parse_critter_id("20"), id(20, 0));
-    assert_eq!(parse_critter_id("#7"), id(7, 0));
-    for bad in ["", "#", "v5", "20v", "x20", "#-1", "20v5v6", "2 0"] {
-        assert_eq!(parse_critter_id(bad), None, "{bad:?}");
-    }
-    // What the engine prints reads back.
-    let c = CritterId {
-        index: 20,
-        generation: 5,
-    };
-    assert_eq!(parse_critter_id(&c.to_string()), Some(c));
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! `World`: the running world as scripts see it (`world()`, `w.step_count`, `w.time`, `w.dt`,
+//! `World`: the running world as scripts see it (`world()`, `w.step_count`, `w.step`, `w.time`, `w.dt`,
 //! `w.gravity`, `w.critters_of(kind)`, `w.count(kind)`, `w.critter(id)`), and its log:
 //! `log(...)`, `print` and `debug`.
 
@@ -40,6 +40,9 @@ pub(super) fn register(api: &mut Api) {
     api.engine.register_fn("world", || WorldRef);
     api.get("step_count", |h| {
         move |_: &mut WorldRef| -> Res<INT> { with_env!(h, env => Ok(env.step_count() as INT)) }
+    });
+    api.get("step", |h| {
+        move |_: &mut WorldRef| -> Res<INT> { with_env!(h, env => Ok(env.step_now() as INT)) }
     });
     api.get("time", |h| {
         move |_: &mut WorldRef| -> Res<f64> { with_env!(h, env => Ok(env.time())) }
